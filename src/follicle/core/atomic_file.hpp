@@ -1,0 +1,20 @@
+#pragma once
+// Outputs are never half-written: write to "<path>.tmp-<pid>" then rename over the target.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+namespace follicle {
+
+/// Calls write(tmp_path); on success renames tmp_path to `path`, otherwise removes it and
+/// rethrows. Creates the parent directory if needed.
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path& tmp)>& write);
+
+/// Writes a byte string atomically.
+void write_file_atomically(const std::filesystem::path& path, const std::string& bytes);
+
+/// Reads a whole file; throws follicle::Error("<path>: cannot open ...") when it cannot.
+std::string read_file(const std::filesystem::path& path);
+
+}  // namespace follicle

@@ -1,0 +1,36 @@
+#pragma once
+// Context: what every long-running function receives instead of globals: a logger, the thread
+// budget (a TBB arena of that size) and the base random seed.
+#include <cstdint>
+#include <memory>
+
+#include <tbb/task_arena.h>
+
+namespace spdlog {
+class logger;
+}
+
+namespace follicle {
+
+class Context {
+ public:
+  /// threads <= 0 means "all hardware threads". The logger defaults to a quiet stderr logger.
+  explicit Context(int threads = 0, uint64_t seed = 1, std::shared_ptr<spdlog::logger> log = {});
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  int threads() const { return m_threads; }
+  uint64_t seed() const { return m_seed; }
+  spdlog::logger& log() const { return *m_log; }
+  std::shared_ptr<spdlog::logger> logger_ptr() const { return m_log; }
+  tbb::task_arena& arena() const { return *m_arena; }
+
+ private:
+  int m_threads;
+  uint64_t m_seed;
+  std::shared_ptr<spdlog::logger> m_log;
+  std::unique_ptr<tbb::task_arena> m_arena;
+};
+
+}  // namespace follicle
