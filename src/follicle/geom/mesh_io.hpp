@@ -1,0 +1,21 @@
+#pragma once
+// Mesh readers/writers: OBJ (tinyobjloader), PLY (ASCII and binary little/big endian), glTF 2.0
+// (.gltf/.glb, tinygltf). The format is chosen by extension. A file's coordinates are in its own
+// declared unit; load_mesh converts them to metres, save_mesh converts back.
+#include <filesystem>
+
+#include "follicle/core/units.hpp"
+#include "follicle/geom/trimesh.hpp"
+
+namespace follicle::geom {
+
+/// Reads a mesh; polygons are fan-triangulated. Throws follicle::Error naming the file (and line
+/// where the format has lines) on malformed input: truncation, NaN/Inf, out-of-range indices,
+/// empty files, unknown extension.
+TriMesh load_mesh(const std::filesystem::path& path, LengthUnit unit);
+/// Writes a mesh atomically (temp file + rename). PLY is written binary little-endian unless
+/// `ascii` is set.
+void save_mesh(const TriMesh& mesh, const std::filesystem::path& path, LengthUnit unit,
+               bool ascii = false);
+
+}  // namespace follicle::geom

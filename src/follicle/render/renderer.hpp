@@ -1,0 +1,28 @@
+#pragma once
+// The OpenGL 3.3 core renderer. create_headless() makes an EGL context (a hardware EGL device
+// when there is one, else Mesa surfaceless / llvmpipe) and renders into an FBO. The same scene
+// and settings give the same bytes on the same machine.
+#include <memory>
+#include <string>
+
+#include "follicle/core/context.hpp"
+#include "follicle/image/image.hpp"
+#include "follicle/render/render_scene.hpp"
+
+namespace follicle::render {
+
+class Renderer {
+ public:
+  /// Throws follicle::Error with a clear message when no EGL/OpenGL 3.3 context can be made.
+  static std::unique_ptr<Renderer> create_headless(const Context& ctx);
+  /// For the viewer: use the caller's current GL 3.3 context (no EGL).
+  static std::unique_ptr<Renderer> create_with_current_context(const Context& ctx);
+  virtual ~Renderer() = default;
+
+  /// Renders to an RGBA8 (sRGB-encoded) image of settings.width x settings.height.
+  virtual image::ImageRGBA8 render(const RenderScene& scene, const RenderSettings& settings) = 0;
+  /// "GL_VERSION / GL_RENDERER", for logs and `follicle info`.
+  virtual std::string device_description() const = 0;
+};
+
+}  // namespace follicle::render
