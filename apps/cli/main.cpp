@@ -1,7 +1,113 @@
-// follicle: command-line front end. (Placeholder until the CLI lands.)
-#include <cstdio>
+// follicle: the command-line front end. This is the only file that includes CLI11 (slow to
+// compile); each subcommand's work is in cmd_*.cpp.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
-int main() {
-  std::puts("follicle");
-  return 0;
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "commands.hpp"
+#include "follicle/core/error.hpp"
+
+namespace {
+
+// One line on stderr: "follicle: error: <message>" (newlines folded so scripts can grep it).
+int report(const std::string& msg, int code) {
+  std::string one = msg;
+  for (auto& c : one)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!one.empty() && one.back() == ' ') one.pop_back();
+  std::fprintf(stderr, "follicle: error: %s\n", one.c_str());
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace follicle::cli;
+  CLI::App app{"follicle: model, animate and render virtual heads (skin wrinkles and hair)",
+               "follicle"};
+  app.require_subcommand(1);
+  app.fallthrough();  // global flags may also follow the subcommand
+  GlobalOptions g;
+  app.add_option("--threads", g.threads, "worker threads (0 = all hardware threads)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--seed", g.seed, "base random seed");
+  auto* quiet = app.add_flag("-q,--quiet", g.quiet, "print only errors");
+  app.add_flag("-v,--verbose", g.verbose, "log what is being done")->excludes(quiet);
+  app.set_version_flag("--version", "follicle 0.1.0");
+
+  RenderArgs ra;
+  auto* render = app.add_subcommand("render", "render a scene to PNG");
+  render->add_option("scene", ra.scene, "scene file (.json)")->required();
+  render->add_option("-o,--output", ra.output, "output PNG (default: the scene's outputs)");
+  render->add_option("--width", ra.width, "image width in pixels (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  render->add_option("--height", ra.height, "image height in pixels (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  render->add_option("--frame", ra.frame, "frame number to render")->check(CLI::NonNegativeNumber);
+
+  ValidateArgs va;
+  auto* validate = app.add_subcommand("validate", "check scene files strictly and load their assets");
+  validate->add_option("scenes", va.scenes, "scene files (.json)")->required();
+
+  InfoArgs ia;
+  auto* info = app.add_subcommand("info", "summarize a scene or mesh file");
+  info->add_option("file", ia.file, "scene (.json) or mesh (.obj, .ply, .gltf, .glb)")->required();
+  info->add_option("--units", ia.units, "length unit of a mesh file: mm, cm, dm, m")
+      ->capture_default_str();
+
+  ConvertArgs ca;
+  auto* convert = app.add_subcommand("convert", "convert a mesh between OBJ, PLY and glTF");
+  convert->add_option("input", ca.input, "input mesh")->required();
+  convert->add_option("output", ca.output, "output mesh (format from the extension)")->required();
+  convert->add_option("--in-units", ca.in_units, "length unit of the input: mm, cm, dm, m")
+      ->capture_default_str();
+  convert->add_option("--out-units", ca.out_units, "length unit to write: mm, cm, dm, m")
+      ->capture_default_str();
+  convert->add_flag("--ascii", ca.ascii, "write PLY as ASCII instead of binary");
+
+  BenchArgs ba;
+  auto* bench = app.add_subcommand("bench", "run benchmark workloads, one JSON line each");
+  bench->add_option("workloads", ba.workloads, "workload names (see --list)");
+  bench->add_option("--size", ba.sizes, "KEY=VALUE size override (repeatable)");
+  bench->add_flag("--list", ba.list, "list the workloads with their default sizes");
+  bench->add_option("--min-seconds", ba.min_seconds, "minimum timed duration per workload")
+      ->capture_default_str();
+
+  DocsArgs da;
+  auto* docs = app.add_subcommand("docs", "");  // hidden: an empty group hides it from --help
+  docs->group("");
+  docs->add_option("topic", da.topic, "scene-format")->required();
+  docs->add_option("--write", da.write, "markdown file whose generated tables to refresh");
+  docs->add_flag("--check", da.check, "fail when the file is out of date (with --write)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help / --version
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    return report(std::string(e.what()) + " (run 'follicle --help')", 2);
+  }
+
+  try {
+    if (*render) return run_render(g, ra);
+    if (*validate) return run_validate(g, va);
+    if (*info) return run_info(g, ia);
+    if (*convert) return run_convert(g, ca);
+    if (*bench) return run_bench(g, ba);
+    if (*docs) return run_docs(g, da);
+    return report("no command given (run 'follicle --help')", 2);
+  } catch (const UsageError& e) {
+    return report(e.what(), 2);
+  } catch (const follicle::Error& e) {
+    return report(e.what(), 1);
+  } catch (const std::exception& e) {
+    return report(std::string("unexpected: ") + e.what(), 1);
+  }
 }

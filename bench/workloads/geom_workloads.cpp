@@ -1,7 +1,137 @@
+// Geometry workloads: mesh load, closest-point queries on the default head, neighbour search.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "follicle/core/error.hpp"
+#include "follicle/core/rng.hpp"
+#include "follicle/geom/grid.hpp"
+#include "follicle/geom/mesh_io.hpp"
+#include "follicle/geom/spatial_embree.hpp"
 #include "workloads/workload.hpp"
 
 namespace follicle::workloads {
 
-void add_geom_workloads(std::vector<Workload>& out) { (void)out; }
+namespace {
+
+namespace fs = std::filesystem;
+
+// The default head: $FOLLICLE_SOURCE_DIR, the compile-time FOLLICLE_SOURCE_DIR if defined, or
+// the current directory and its parents.
+fs::path default_head_path() {
+  const fs::path rel = "data/meshes/lee_perry_smith/head.obj";
+  if (const char* s = std::getenv("FOLLICLE_SOURCE_DIR"); s && *s) return fs::path(s) / rel;
+#ifdef FOLLICLE_SOURCE_DIR
+  if (fs::exists(fs::path(FOLLICLE_SOURCE_DIR) / rel)) return fs::path(FOLLICLE_SOURCE_DIR) / rel;
+#endif
+  for (fs::path d = fs::current_path(); !d.empty(); d = d.parent_path()) {
+    if (fs::exists(d / rel)) return d / rel;
+    if (d == d.root_path()) break;
+  }
+  fail("cannot find the default head '{}': run from the repository or set FOLLICLE_SOURCE_DIR",
+       rel.string());
+}
+
+std::size_t size_of(const Sizes& s, const char* key, double lo) {
+  const double v = s.at(key);
+  if (!(v >= lo) || !std::isfinite(v) || v > 1e10)
+    fail("size '{}' = {} is out of range: expected a number >= {}", key, v, lo);
+  return std::size_t(std::llround(v));
+}
+
+class MeshLoad : public WorkloadInstance {
+ public:
+  MeshLoad() : m_path(default_head_path()) {}
+  void run_once() override {
+    const geom::TriMesh m = geom::load_mesh(m_path, LengthUnit::mm);
+    m_faces = m.num_faces();
+  }
+  double items_per_iter() const override { return 1.0; }
+
+ private:
+  fs::path m_path;
+  std::size_t m_faces = 0;
+};
+
+class ClosestPointQueries : public WorkloadInstance {
+ public:
+  ClosestPointQueries(const Context& ctx, std::size_t n)
+      : m_ctx(ctx), m_query(geom::load_mesh(default_head_path(), LengthUnit::mm)) {
+    // Query points spread through the head's bounding box enlarged by 20%, so some lie inside,
+    // some on and some away from the surface (as for hair roots and collision probes).
+    Eigen::AlignedBox3d box;
+    for (const Vec3& p : m_query.positions()) box.extend(p);
+    const Vec3 lo = box.min() - 0.1 * box.sizes(), size = 1.2 * box.sizes();
+    m_points.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      Rng rng = Rng::stream(ctx.seed(), i);
+      m_points[i] = lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()).cwiseProduct(size);
+    }
+  }
+  void run_once() override { m_result = m_query.closest_points(m_ctx, m_points); }
+  double items_per_iter() const override { return double(m_points.size()); }
+
+ private:
+  const Context& m_ctx;
+  geom::MeshQuery m_query;
+  std::vector<Vec3> m_points;
+  std::vector<geom::ClosestPoint> m_result;
+};
+
+class NeighbourSearch : public WorkloadInstance {
+ public:
+  NeighbourSearch(const Context& ctx, std::size_t n, double radius) : m_ctx(ctx), m_radius(float(radius)) {
+    // Uniform random particles in a unit cube.
+    m_points.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      Rng rng = Rng::stream(ctx.seed(), i);
+      m_points[i] = Vec3f(float(rng.uniform()), float(rng.uniform()), float(rng.uniform()));
+    }
+  }
+  // Build the grid and all neighbour lists (what an SPH step does).
+  void run_once() override {
+    m_grid.build(m_ctx, m_points, m_radius);
+    m_lists = m_grid.neighbour_lists(m_ctx, m_radius);
+  }
+  double items_per_iter() const override { return double(m_points.size()); }
+  double mean_neighbours() const {
+    return m_points.empty() ? 0.0 : double(m_lists.index.size()) / double(m_points.size());
+  }
+
+ private:
+  const Context& m_ctx;
+  float m_radius;
+  std::vector<Vec3f> m_points;
+  geom::NeighbourGrid m_grid;
+  geom::NeighbourList m_lists;
+};
+
+}  // namespace
+
+void add_geom_workloads(std::vector<Workload>& out) {
+  out.push_back({"mesh-load", "load the default head OBJ (8838 vertices) and convert mm to m", {},
+                 "meshes/s", [](const Context&, const Sizes&) {
+                   return std::unique_ptr<WorkloadInstance>(new MeshLoad());
+                 }});
+  out.push_back({"closest-point",
+                 "closest surface point on the default head (Embree) for random points around it",
+                 {{"queries", 1e6}}, "queries/s", [](const Context& ctx, const Sizes& s) {
+                   return std::unique_ptr<WorkloadInstance>(
+                       new ClosestPointQueries(ctx, size_of(s, "queries", 1)));
+                 }});
+  // Radius for ~12 neighbours among n uniform points in a unit cube: (4/3) pi r^3 n = 12.
+  const double r12 = std::cbrt(12.0 * 3.0 / (4.0 * kPi * 1e6));
+  out.push_back({"neighbour-search",
+                 "uniform-grid build + fixed-radius neighbour lists over random particles in a "
+                 "unit cube (default radius gives ~12 neighbours at 1M particles)",
+                 {{"particles", 1e6}, {"radius", r12}}, "particles/s",
+                 [](const Context& ctx, const Sizes& s) {
+                   const double r = s.at("radius");
+                   if (!(r > 0) || !std::isfinite(r))
+                     fail("size 'radius' = {} must be a positive number", r);
+                   return std::unique_ptr<WorkloadInstance>(
+                       new NeighbourSearch(ctx, size_of(s, "particles", 1), r));
+                 }});
+}
 
 }  // namespace follicle::workloads

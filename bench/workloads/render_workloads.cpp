@@ -1,7 +1,64 @@
+// Rendering workloads: "render-head" renders the textured default head at 1024^2 headless.
+#include <cstdlib>
+#include <filesystem>
+
+#include "follicle/core/error.hpp"
+#include "follicle/render/framing.hpp"
+#include "follicle/render/renderer.hpp"
 #include "workloads/workload.hpp"
 
 namespace follicle::workloads {
+namespace {
 
-void add_render_workloads(std::vector<Workload>& out) { (void)out; }
+/// data/meshes/lee_perry_smith: $FOLLICLE_DATA_DIR, else the first `data` folder found walking
+/// up from the working directory (the repository root or a build folder inside it).
+std::filesystem::path find_head_dir() {
+  const std::filesystem::path rel = "meshes/lee_perry_smith";
+  if (const char* env = std::getenv("FOLLICLE_DATA_DIR")) {
+    if (std::filesystem::exists(std::filesystem::path(env) / rel / "head.obj"))
+      return std::filesystem::path(env) / rel;
+  }
+  std::filesystem::path p = std::filesystem::current_path();
+  for (int i = 0; i < 6; ++i) {
+    if (std::filesystem::exists(p / "data" / rel / "head.obj")) return p / "data" / rel;
+    if (!p.has_parent_path() || p.parent_path() == p) break;
+    p = p.parent_path();
+  }
+  fail("render-head: cannot find data/{}/head.obj (run from the repository or set FOLLICLE_DATA_DIR)",
+       rel.string());
+}
+
+class RenderHead final : public WorkloadInstance {
+ public:
+  RenderHead(const Context& ctx, const Sizes& sz) {
+    m_settings.width = int(sz.at("width"));
+    m_settings.height = int(sz.at("height"));
+    m_settings.supersample = int(sz.at("supersample"));
+    m_settings.validate();
+    m_scene = render::make_head_scene(find_head_dir(), sz.at("lafortune") != 0);
+    m_renderer = render::Renderer::create_headless(ctx);
+    (void)m_renderer->render(m_scene, m_settings);  // warm-up: shaders, targets, textures
+  }
+  void run_once() override { (void)m_renderer->render(m_scene, m_settings); }
+  double items_per_iter() const override { return 1.0; }
+
+ private:
+  render::RenderScene m_scene;
+  render::RenderSettings m_settings;
+  std::unique_ptr<render::Renderer> m_renderer;
+};
+
+}  // namespace
+
+void add_render_workloads(std::vector<Workload>& out) {
+  out.push_back(Workload{
+      "render-head",
+      "render the textured default head (Lee Perry-Smith, 8.8k triangles, shadow map) headless",
+      {{"width", 1024}, {"height", 1024}, {"supersample", 2}, {"lafortune", 0}},
+      "frames/s",
+      [](const Context& ctx, const Sizes& sz) -> std::unique_ptr<WorkloadInstance> {
+        return std::make_unique<RenderHead>(ctx, sz);
+      }});
+}
 
 }  // namespace follicle::workloads

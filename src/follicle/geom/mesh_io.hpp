@@ -18,4 +18,9 @@ TriMesh load_mesh(const std::filesystem::path& path, LengthUnit unit);
 void save_mesh(const TriMesh& mesh, const std::filesystem::path& path, LengthUnit unit,
                bool ascii = false);
 
+/// Returns a copy whose UVs are per position vertex (uv_faces == faces, uvs.size() ==
+/// positions.size()), splitting vertices along UV seams. Formats and GPU buffers that store one
+/// attribute set per vertex (PLY, glTF, OpenGL) need this. A mesh without UVs is returned as is.
+TriMesh split_uv_seams(const TriMesh& mesh);
+
 }  // namespace follicle::geom

@@ -3,6 +3,7 @@
 // [offsets[s], offsets[s+1]). Point 0 of a strand is its root. Per-point radius [m] and linear
 // RGB colour are optional (empty or one entry per point).
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "follicle/core/types.hpp"

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "follicle/core/params.hpp"
 #include "follicle/core/types.hpp"
 #include "follicle/geom/strands.hpp"
 #include "follicle/geom/trimesh.hpp"
@@ -20,6 +21,18 @@ struct Camera {
   double fov_y = 0.6;   // [rad] vertical field of view
   double z_near = 0.01; // [m]
   double z_far = 100.0; // [m]
+
+  template <class V>
+  void visit(V&& v) {
+    v("eye", eye, ParamInfo{"camera position", "m"});
+    v("target", target, ParamInfo{"point looked at", "m"});
+    v("up", up, ParamInfo{"up direction", ""});
+    v("fov_y", fov_y, ParamInfo{"vertical field of view", "rad", 1e-3, 3.1});
+    v("z_near", z_near, ParamInfo{"near clip distance", "m", 1e-6, 1e6});
+    v("z_far", z_far, ParamInfo{"far clip distance", "m", 1e-5, 1e9});
+  }
+  /// Also checks eye != target, up not parallel to the view direction and z_near < z_far.
+  void validate() const;
 };
 
 struct DirectionalLight {
@@ -121,6 +134,17 @@ struct RenderSettings {
   int height = 800;
   int supersample = 2;   // render at (supersample * size) and box-filter down
   int shadow_map_size = 2048;
+  bool transparent_background = false;  // background alpha 0 instead of 1 (output alpha = coverage)
+
+  template <class V>
+  void visit(V&& v) {
+    v("width", width, ParamInfo{"output width", "px", 1, 16384});
+    v("height", height, ParamInfo{"output height", "px", 1, 16384});
+    v("supersample", supersample, ParamInfo{"supersampling factor per axis", "", 1, 8});
+    v("shadow_map_size", shadow_map_size, ParamInfo{"shadow map resolution", "px", 16, 16384});
+    v("transparent_background", transparent_background, ParamInfo{"background alpha 0", ""});
+  }
+  void validate() const { validate_params(*this, "render"); }
 };
 
 }  // namespace follicle::render

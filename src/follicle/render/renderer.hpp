@@ -20,7 +20,13 @@ class Renderer {
   virtual ~Renderer() = default;
 
   /// Renders to an RGBA8 (sRGB-encoded) image of settings.width x settings.height.
+  /// Not thread-safe: call from one thread at a time (it makes its GL context current).
+  /// Throws follicle::Error on invalid settings/scene data (naming the item) or a GL error.
   virtual image::ImageRGBA8 render(const RenderScene& scene, const RenderSettings& settings) = 0;
+  /// For the viewer: renders like render() and blits the sRGB-encoded result to (0, 0) of the
+  /// caller's framebuffer object `target_fbo` (0 = default framebuffer), leaving it bound.
+  virtual void render_to_framebuffer(const RenderScene& scene, const RenderSettings& settings,
+                                     unsigned target_fbo) = 0;
   /// "GL_VERSION / GL_RENDERER", for logs and `follicle info`.
   virtual std::string device_description() const = 0;
 };

@@ -1,0 +1,74 @@
+#pragma once
+// The `follicle` subcommands. main.cpp (the only file that includes CLI11, which is slow to
+// compile) parses the command line into these structs and calls run_*; each run_* lives in its
+// own cmd_*.cpp. A run_* returns the process exit code or throws: follicle::Error -> exit 1,
+// UsageError -> exit 2, both printed as one line "follicle: error: <message>".
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "follicle/core/context.hpp"
+
+namespace follicle::cli {
+
+/// A command-line mistake the parser could not catch (e.g. a malformed --size); exit code 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct GlobalOptions {
+  int threads = 0;  // 0 = all hardware threads
+  uint64_t seed = 1;
+  bool quiet = false;
+  bool verbose = false;
+};
+
+/// The Context every command runs with (logger level from --quiet/--verbose).
+std::unique_ptr<Context> make_context(const GlobalOptions& g);
+
+struct RenderArgs {
+  std::string scene;
+  std::string output;  // "" = the scene's outputs
+  int width = 0;       // 0 = from the scene
+  int height = 0;
+  int frame = 0;
+};
+int run_render(const GlobalOptions& g, const RenderArgs& a);
+
+struct ValidateArgs {
+  std::vector<std::string> scenes;
+};
+int run_validate(const GlobalOptions& g, const ValidateArgs& a);
+
+struct InfoArgs {
+  std::string file;
+  std::string units = "m";  // for mesh files
+};
+int run_info(const GlobalOptions& g, const InfoArgs& a);
+
+struct ConvertArgs {
+  std::string input, output;
+  std::string in_units = "m", out_units = "m";
+  bool ascii = false;
+};
+int run_convert(const GlobalOptions& g, const ConvertArgs& a);
+
+struct BenchArgs {
+  std::vector<std::string> workloads;
+  std::vector<std::string> sizes;  // "KEY=VALUE"
+  bool list = false;
+  double min_seconds = 1.0;
+};
+int run_bench(const GlobalOptions& g, const BenchArgs& a);
+
+struct DocsArgs {
+  std::string topic;   // "scene-format"
+  std::string write;   // file to update in place, "" = print the tables
+  bool check = false;  // exit 1 when the file is out of date
+};
+int run_docs(const GlobalOptions& g, const DocsArgs& a);
+
+}  // namespace follicle::cli

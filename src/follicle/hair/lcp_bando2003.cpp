@@ -1,0 +1,681 @@
+#include "follicle/hair/lcp_bando2003.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+#include "follicle/core/error.hpp"
+#include "follicle/core/parallel.hpp"
+#include "follicle/core/rng.hpp"
+#include "follicle/hair/sph_kernel.hpp"
+
+namespace follicle::hair {
+
+void LcpInitParams::validate() const {
+  validate_params(*this, "lcp_init");
+  if (gravity_dir.norm() < 1e-9) fail_at("lcp_init.gravity_dir", "must not be the zero vector");
+  if (std::abs(w_t) + std::abs(w_n) <= 0) fail_at("lcp_init.w_n", "w_t and w_n are both zero");
+}
+
+void LcpParams::validate() const {
+  validate_params(*this, "lcp");
+  contact.validate();
+}
+
+Vec3 root_direction(const Vec3& n_w, const Vec3& n, double w_t, double w_n) {
+  // (3.4) t_r = -w_t {n_w - (n_w . n) n} + w_n n
+  return -w_t * (n_w - n_w.dot(n) * n) + w_n * n;
+}
+
+std::vector<double> sph_density(const Context& ctx, const std::vector<Vec3>& x,
+                                const std::vector<double>& mass, double h) {
+  if (x.size() != mass.size()) fail("sph_density: {} positions but {} masses", x.size(), mass.size());
+  if (!(h > 0)) fail("sph_density: smoothing length {} must be > 0", h);
+  ParticleGrid grid;
+  grid.build(x, 2 * h);
+  std::vector<double> rho(x.size());
+  parallel_for(ctx, 0, x.size(), [&](std::size_t i) {
+    double r = mass[i] * sph_w(h, 0.0);
+    grid.for_each_candidate(x[i], [&](uint32_t j) {
+      if (j == i) return;
+      const double d = (x[j] - x[i]).norm();
+      if (d < 2 * h) r += mass[j] * sph_w(h, d);  // (3.1)
+    });
+    rho[i] = r;
+  });
+  return rho;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Initialisation (§3.3.1)
+
+LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
+                           const std::vector<Vec3>& t_in, const std::vector<Vec3>& uvs,
+                           const std::vector<double>& mass, const LcpInitParams& p) {
+  p.validate();
+  const std::size_t n = x.size();
+  if (n < 2) fail_at("lcp", "need at least 2 particles, got {}", n);
+  if (t_in.size() != n || uvs.size() != n || mass.size() != n)
+    fail_at("lcp", "particle arrays differ in size: {} positions, {} directions, {} uvs, {} masses",
+            n, t_in.size(), uvs.size(), mass.size());
+  LcpModel m;
+  m.rest_x = x;
+  m.rest_t.resize(n);
+  m.uvs = uvs;
+  m.mass = mass;
+  m.root.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!x[i].allFinite() || !t_in[i].allFinite() || !uvs[i].allFinite())
+      fail_at(fmt::format("lcp.particles[{}]", i), "position, direction or (u,v,s) not finite");
+    if (t_in[i].norm() < 1e-12)
+      fail_at(fmt::format("lcp.particles[{}]", i), "hair direction is the zero vector");
+    if (!(mass[i] > 0) || !std::isfinite(mass[i]))
+      fail_at(fmt::format("lcp.particles[{}]", i), "mass {} must be > 0", mass[i]);
+    m.rest_t[i] = t_in[i].normalized();
+    m.root[i] = uvs[i].z() < 0 ? 1 : 0;
+  }
+  const auto& t = m.rest_t;
+  // Mean nearest-neighbour distance sets h_s and h.
+  ParticleGrid grid;
+  const double search = 3.0 * p.spacing;
+  grid.build(x, search);
+  std::vector<double> nn(n, 0.0);
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    double best = search * search;
+    grid.for_each_candidate(x[i], [&](uint32_t j) {
+      if (j != i) best = std::min(best, (x[j] - x[i]).squaredNorm());
+    });
+    nn[i] = best < search * search ? std::sqrt(best) : 0.0;
+  });
+  double sum = 0;
+  std::size_t cnt = 0;
+  for (double d : nn)
+    if (d > 0) {
+      sum += d;
+      ++cnt;
+    }
+  if (cnt == 0 || !(sum > 0))
+    fail_at("lcp_init.spacing", "no particle has a neighbour within 3 x spacing = {} m", search);
+  m.spacing = sum / double(cnt);
+  m.h_s = p.hs_factor * m.spacing;
+  m.h = p.h_factor * m.spacing;
+
+  // Candidate pairs within 2 h_s.
+  grid.build(x, 2 * m.h_s);
+  std::vector<uint32_t> off, nb;
+  grid.neighbour_lists(ctx, x, 2 * m.h_s, off, nb);
+  struct Cand {
+    uint32_t a, b;
+    double l0, c, ca, cb, strength;
+  };
+  std::vector<Cand> cands;
+  for (std::size_t i = 0; i < n; ++i)
+    for (uint32_t q = off[i]; q < off[i + 1]; ++q) {
+      const uint32_t j = nb[q];
+      if (j <= i || (m.root[i] && m.root[j])) continue;
+      const Vec3 d = x[j] - x[i];
+      const double l0 = d.norm();
+      if (l0 <= 0) continue;
+      const Vec3 xh = d / l0;
+      // theta0_ij: angle between t_i and x_ij; theta0_ji: angle between t_j and the same pair
+      // direction x_ij (measuring it against x_ji instead would make every aligned pair fail the
+      // sign test of (3.6)).
+      const double ci = t[i].dot(xh), cj = t[j].dot(xh);
+      const double a = ci * cj > 0 ? std::abs((ci + cj) / 2) : 0.0;  // (3.6)
+      if (a <= 0 || a < p.a0) continue;
+      Cand c;
+      if (ci > 0) {  // j lies towards the tip of i
+        c = {uint32_t(i), j, l0, a * l0, ci, cj, 0};
+      } else {
+        c = {j, uint32_t(i), l0, a * l0, -cj, -ci, 0};
+      }
+      c.c = a * l0;                           // (3.5) c_ij = a_ij l0_ij
+      c.strength = c.c * sph_w(m.h_s, l0);    // initial spring coefficient (3.7)
+      cands.push_back(c);
+    }
+  // Remove the weakest connections while both ends keep more than N_n.
+  std::vector<uint32_t> order(cands.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t u, uint32_t w) {
+    return cands[u].strength < cands[w].strength;
+  });
+  std::vector<int> deg(n, 0);
+  for (const auto& c : cands) {
+    ++deg[c.a];
+    ++deg[c.b];
+  }
+  std::vector<char> keep(cands.size(), 1);
+  for (uint32_t q : order) {
+    const auto& c = cands[q];
+    if (deg[c.a] > p.n_n && deg[c.b] > p.n_n) {
+      keep[q] = 0;
+      --deg[c.a];
+      --deg[c.b];
+    }
+  }
+  for (std::size_t q = 0; q < cands.size(); ++q) {
+    if (!keep[q]) continue;
+    const auto& c = cands[q];
+    m.pair_a.push_back(c.a);
+    m.pair_b.push_back(c.b);
+    m.l0.push_back(c.l0);
+    m.c.push_back(c.c);
+    m.cos_a.push_back(c.ca);
+    m.cos_b.push_back(c.cb);
+  }
+  m.adj_offsets.assign(n + 1, 0);
+  for (std::size_t q = 0; q < m.l0.size(); ++q) {
+    ++m.adj_offsets[m.pair_a[q] + 1];
+    ++m.adj_offsets[m.pair_b[q] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) m.adj_offsets[i + 1] += m.adj_offsets[i];
+  m.adj_pairs.resize(m.adj_offsets[n]);
+  std::vector<uint32_t> fill(m.adj_offsets.begin(), m.adj_offsets.end() - 1);
+  for (std::size_t q = 0; q < m.l0.size(); ++q) {
+    m.adj_pairs[fill[m.pair_a[q]]++] = uint32_t(q);
+    m.adj_pairs[fill[m.pair_b[q]]++] = uint32_t(q);
+  }
+  const auto rho = sph_density(ctx, x, mass, m.h);
+  double rs = 0;
+  std::size_t rc = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!m.root[i]) {
+      rs += rho[i];
+      ++rc;
+    }
+  m.rest_density = rc ? rs / double(rc) : 0.0;
+  return m;
+}
+
+namespace {
+
+uint64_t cell_key(const Vec3& p, double s, double r) {
+  auto f = [](double v) { return uint64_t(uint32_t(int64_t(std::floor(v)) + (1 << 15)) & 0xFFFFu); };
+  return f(p.x() / r) | (f(p.y() / r) << 16) | (f(p.z() / r) << 32) | (f(s / r) << 48);
+}
+
+struct Chain {
+  Vec3 x, t;
+};
+
+// The particle is the end of a cantilever chain of length s_i from its root (Anjyo et al. 1992
+// as used by §3.3.1). Hand-written here: each segment bends towards gravity by the moment of the
+// remaining strand, dtheta = (w/EI) (L - s)^2 / 2 sin(phi) ds, never past the gravity direction,
+// and a segment entering the body is turned along the body plane.
+Chain cantilever_chain(const ScalpPoint& sp, const Vec3& tr, double L, double s,
+                       const LcpInitParams& p, const sim::VoxelPlanes* body) {
+  if (s <= 0) return {sp.position + s * tr, tr};  // (3.3) root particles
+  const Vec3 g = p.gravity_dir.normalized();
+  const int nseg = p.cantilever_segments;
+  const double ds = std::max(L, s) / nseg;
+  Vec3 x = sp.position, d = tr;
+  double arc = 0;
+  while (arc < s - 1e-12) {
+    const double seg = std::min(ds, s - arc);
+    const Vec3 axis = d.cross(g);
+    const double sphi = axis.norm();
+    if (sphi > 1e-12) {
+      const double phi = std::atan2(sphi, d.dot(g));
+      const double rem = std::max(L - arc, 0.0);
+      const double dth = std::min(phi, p.cantilever_sag * rem * rem / 2 * sphi * seg);
+      d = Eigen::AngleAxisd(dth, axis / sphi) * d;
+    }
+    if (body) {
+      const Vec3 q = x + d * seg;
+      if (const sim::BodyPlane* pl = body->find(q)) {
+        const double dist = (q - pl->p).dot(pl->n);
+        if (dist < p.body_clearance) {
+          const double dn = d.dot(pl->n);
+          if (dn < 0) d = (d - dn * pl->n);
+          d += (p.body_clearance - dist) / seg * pl->n;
+          d.normalize();
+        }
+      }
+    }
+    x += d * seg;
+    arc += seg;
+  }
+  return {x, d};
+}
+
+}  // namespace
+
+LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitParams& p,
+                       const sim::VoxelPlanes* body) {
+  p.validate();
+  const double r = p.spacing;
+  const double sr = scalp.root_depth();
+  const double lmax = scalp.max_length();
+  const Vec3 n_w = scalp.point(scalp.nearest_uv(p.whirl_point)).normal;
+  Rng rng = Rng::stream(ctx.seed(), 0x4c4350ull);
+  struct Sample {
+    Vec2 uv;
+    double s;
+    Vec3 pos;
+  };
+  std::vector<Sample> samples;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> cells;
+  const int max_miss = p.attempts_per_particle * 50;
+  int miss = 0;
+  while (miss < max_miss && int(samples.size()) < p.max_particles) {
+    const Vec2 uv = scalp.sample_uv(rng);
+    const double L = scalp.length(uv);
+    // Volume-uniform in the pillar -s_r <= s <= L(u, v).
+    if (rng.uniform() * (lmax + sr) > L + sr) {
+      ++miss;
+      continue;
+    }
+    const double s = -sr + rng.uniform() * (L + sr);
+    const Vec3 pos = scalp.point(uv).position;
+    bool ok = true;
+    for (int dw = -1; dw <= 1 && ok; ++dw)
+      for (int dz = -1; dz <= 1 && ok; ++dz)
+        for (int dy = -1; dy <= 1 && ok; ++dy)
+          for (int dx = -1; dx <= 1 && ok; ++dx) {
+            const Vec3 o(dx * r, dy * r, dz * r);
+            auto it = cells.find(cell_key(pos + o, s + dw * r, r));
+            if (it == cells.end()) continue;
+            for (uint32_t j : it->second) {
+              const Sample& q = samples[j];
+              // (3.2) d^2 = |phi^-1(u1,v1) - phi^-1(u2,v2)|^2 + (s1 - s2)^2
+              const double d2 = (q.pos - pos).squaredNorm() + (q.s - s) * (q.s - s);
+              if (d2 < r * r) {
+                ok = false;
+                break;
+              }
+            }
+          }
+    if (!ok) {
+      ++miss;
+      continue;
+    }
+    miss = 0;
+    cells[cell_key(pos, s, r)].push_back(uint32_t(samples.size()));
+    samples.push_back({uv, s, pos});
+  }
+  if (samples.size() < 2)
+    fail_at("lcp_init.spacing", "only {} particle(s) fit the scalp with spacing {} m",
+            samples.size(), r);
+  const std::size_t n = samples.size();
+  std::vector<Vec3> x(n), t(n), uvs(n);
+  std::vector<double> mass(n, p.total_mass / double(n));
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    const Sample& q = samples[i];
+    const ScalpPoint sp = scalp.point(q.uv);
+    Vec3 tr = root_direction(n_w, sp.normal, p.w_t, p.w_n);  // (3.4)
+    tr = tr.norm() > 1e-12 ? Vec3(tr.normalized()) : sp.normal;
+    const Chain c = cantilever_chain(sp, tr, scalp.length(q.uv), q.s, p, body);
+    x[i] = c.x;  // (3.3) along the cantilever shape instead of the straight root direction
+    t[i] = c.t;
+    uvs[i] = Vec3(q.uv.x(), q.uv.y(), q.s);
+  });
+  LcpInit out;
+  out.model = connect_particles(ctx, x, t, uvs, mass, p);
+  out.state.x = out.model.rest_x;
+  out.state.t = out.model.rest_t;
+  out.state.v.assign(n, Vec3::Zero());
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Dynamics
+
+LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPlanes* body)
+    : m_params(params), m_model(std::move(model)), m_body(body) {
+  m_params.validate();
+  const std::size_t n = m_model.size();
+  if (n == 0) fail_at("lcp", "the particle model is empty");
+  if (m_model.rest_x.size() != n || m_model.rest_t.size() != n || m_model.root.size() != n ||
+      m_model.adj_offsets.size() != n + 1)
+    fail_at("lcp", "inconsistent particle model arrays");
+  if (!(m_model.h > 0) || !(m_model.h_s > 0)) fail_at("lcp", "smoothing lengths must be > 0");
+  for (std::size_t q = 0; q < m_model.num_pairs(); ++q)
+    if (m_model.pair_a[q] >= n || m_model.pair_b[q] >= n)
+      fail_at(fmt::format("lcp.pairs[{}]", q), "particle index out of range");
+  m_rho0 = m_params.rho0_scale * m_model.rest_density;
+}
+
+LcpState LcpSolver::rest_state() const {
+  LcpState s;
+  s.x = m_model.rest_x;
+  s.t = m_model.rest_t;
+  s.v.assign(m_model.size(), Vec3::Zero());
+  return s;
+}
+
+double LcpSolver::cross_section(std::size_t i) const {
+  return std::pow(m_model.mass[i] / m_params.material_density, 2.0 / 3.0);  // (3.9)
+}
+
+void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
+  const auto& m = m_model;
+  const std::size_t np = m.num_pairs(), n = m.size();
+  ws.k.resize(np);
+  ws.alpha.resize(np);
+  ws.alpha_r.resize(n);
+  ws.alpha_t.resize(n);
+  parallel_for(ctx, 0, np, [&](std::size_t q) {
+    const double d = (s.x[m.pair_b[q]] - s.x[m.pair_a[q]]).norm();
+    ws.k[q] = m.c[q] * sph_w(m.h_s, d);  // (3.7) k_ij = c_ij W(h_s, |x_ij|)
+  });
+  const double E = m_params.elastic_modulus;
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    double sr = 0, st = 0;
+    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+      const uint32_t q = m.adj_pairs[e];
+      if (m.pair_b[q] == i)
+        sr += m.l0[q] * ws.k[q];  // the other end is in N_r(i)
+      else
+        st += m.l0[q] * ws.k[q];  // the other end is in N_t(i)
+    }
+    const double ea = E * cross_section(i);
+    ws.alpha_r[i] = sr > 0 ? ea / sr : 0.0;  // (3.13)
+    ws.alpha_t[i] = st > 0 ? ea / st : 0.0;
+  });
+  parallel_for(ctx, 0, np, [&](std::size_t q) {
+    // (3.14): a = pair_a is root-side (in N_r(b)), b is tip-side (in N_t(a)).
+    ws.alpha[q] = 0.5 * (ws.alpha_r[m.pair_b[q]] + ws.alpha_t[m.pair_a[q]]);
+  });
+  // Optional balancing (not in the paper): the average (3.14) satisfies neither (3.10) nor
+  // (3.11) exactly. Each sweep scales alpha_ij by the geometric mean of E / E_{r,b} and
+  // E / E_{t,a} of its two ends (iterative proportional fitting); still linear time.
+  for (int sweep = 0; sweep < m_params.alpha_sweeps; ++sweep) {
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      double er = 0, et = 0;
+      for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+        const uint32_t q = m.adj_pairs[e];
+        const double c = m.l0[q] * ws.alpha[q] * ws.k[q];
+        if (m.pair_b[q] == i)
+          er += c;
+        else
+          et += c;
+      }
+      const double ea = E * cross_section(i);
+      ws.alpha_r[i] = er > 0 ? ea / er : 1.0;  // reused as correction factors
+      ws.alpha_t[i] = et > 0 ? ea / et : 1.0;
+    });
+    parallel_for(ctx, 0, np, [&](std::size_t q) {
+      ws.alpha[q] *= std::sqrt(ws.alpha_r[m.pair_b[q]] * ws.alpha_t[m.pair_a[q]]);
+    });
+  }
+}
+
+void LcpSolver::tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
+                               std::vector<double>& e_t) const {
+  const auto& m = m_model;
+  e_r.assign(m.size(), 0.0);
+  e_t.assign(m.size(), 0.0);
+  for (std::size_t q = 0; q < m.num_pairs(); ++q) {
+    const double c = m.l0[q] * ws.alpha[q] * ws.k[q];
+    e_r[m.pair_b[q]] += c;  // (3.10)
+    e_t[m.pair_a[q]] += c;  // (3.11)
+  }
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const double a = cross_section(i);
+    e_r[i] /= a;
+    e_t[i] /= a;
+  }
+}
+
+void LcpSolver::neighbours_and_density(const Context& ctx, const LcpState& s,
+                                       LcpWorkspace& ws) const {
+  const double h = m_model.h;
+  ws.grid.build(s.x, 2 * h);
+  ws.grid.neighbour_lists(ctx, s.x, 2 * h, ws.nbr_offsets, ws.nbrs);
+  const std::size_t n = m_model.size();
+  ws.density.resize(n);
+  ws.pressure.resize(n);
+  const double w0 = sph_w(h, 0.0);
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    double rho = m_model.mass[i] * w0;
+    for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+      const uint32_t j = ws.nbrs[e];
+      rho += m_model.mass[j] * sph_w(h, (s.x[j] - s.x[i]).norm());  // (3.1)
+    }
+    ws.density[i] = rho;
+    ws.pressure[i] = m_params.k_a * (rho - m_rho0);  // P = k_a (rho - rho0)
+  });
+}
+
+namespace {
+
+// Force of loose spring q on its root-side end a (the tip-side end b gets the negation).
+inline Vec3 spring_force_on_a(const LcpModel& m, const LcpParams& p, const LcpState& s,
+                              const LcpWorkspace& ws, uint32_t q) {
+  const uint32_t a = m.pair_a[q], b = m.pair_b[q];
+  const Vec3 d = s.x[b] - s.x[a];
+  const double r = d.norm();
+  if (r <= 0) return Vec3::Zero();
+  const Vec3 xh = d / r;
+  const double ak = ws.alpha[q] * ws.k[q];  // current coefficient alpha_ij k_ij
+  const double ext = r - m.l0[q];
+  // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
+  const double kk = ext < 0 ? ak * p.compression_scale : ak;
+  const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
+  const double cd = 2.0 * p.spring_damping * std::sqrt(kk * mu);
+  return (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
+}
+
+// Hair-hair force (3.16)-(3.18) on particle a from particle b; always called with a < b so that
+// the pair's force is computed once per ordering and negated exactly for b.
+inline Vec3 hair_force_on_a(const LcpModel& m, const LcpParams& p, const LcpState& s,
+                            const LcpWorkspace& ws, uint32_t a, uint32_t b) {
+  const Vec3 xab = s.x[b] - s.x[a];
+  const double r = xab.norm();
+  if (r <= 0) return Vec3::Zero();
+  const Vec3 xh = xab / r;
+  const double h = m.h;
+  // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i, dW/dx_i = -W' x^_ij
+  const double pr = ws.pressure[a] / (ws.density[a] * ws.density[a]) +
+                    ws.pressure[b] / (ws.density[b] * ws.density[b]);
+  Vec3 f = m.mass[a] * m.mass[b] * pr * sph_dw(h, r) * xh;
+  // Collision direction d_n = t_i x t_j. Near-colinear hairs: the paper prints
+  // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is t_i, i.e.
+  // ALONG the hair, contradicting "normal to the hair directions". We use the part of x^_ij
+  // normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which is what the case needs.
+  Vec3 dn = s.t[a].cross(s.t[b]);
+  if (dn.norm() < p.colinear_eps) dn = xh - xh.dot(s.t[a]) * s.t[a];
+  const double dnn = dn.norm();
+  if (dnn < 1e-9) return f;
+  const Vec3 dh = dn / dnn;
+  const Vec3 vab = s.v[b] - s.v[a];
+  // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one setting
+  // works for any particle count: d_c(paper) = d_c mu / W(h, 0).
+  const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
+  const double w = sph_w(h, r) / sph_w(h, 0.0);
+  const double vn = vab.dot(dh);
+  if (vn * xab.dot(dh) < 0) f += p.collision_damping * mu * w * vn * dh;  // (3.17) inelastic
+  const Vec3 dt = vab - vn * dh;
+  f += p.friction_damping * mu * w * dt;  // (3.18) = d_f W (v_ij . d^_t) d^_t
+  return f;
+}
+
+}  // namespace
+
+void LcpSolver::pair_forces(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
+  const auto& m = m_model;
+  const std::size_t n = m.size();
+  ws.force.resize(n);
+  const bool hh = m_params.hair_hair && !ws.nbr_offsets.empty() && ws.density.size() == n;
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    Vec3 f = Vec3::Zero();
+    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+      const uint32_t q = m.adj_pairs[e];
+      const Vec3 fa = spring_force_on_a(m, m_params, s, ws, q);
+      f += m.pair_a[q] == i ? fa : Vec3(-fa);
+    }
+    if (hh) {
+      for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+        const uint32_t j = ws.nbrs[e];
+        if (i < j)
+          f += hair_force_on_a(m, m_params, s, ws, uint32_t(i), j);
+        else
+          f -= hair_force_on_a(m, m_params, s, ws, j, uint32_t(i));
+      }
+    }
+    ws.force[i] = f;
+  });
+}
+
+void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWorkspace& ws) const {
+  const auto& m = m_model;
+  parallel_for(ctx, 0, m.size(), [&](std::size_t i) {
+    if (m.root[i]) return;
+    Vec3 acc = Vec3::Zero();
+    const Vec3 ti = s.t[i];
+    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+      const uint32_t q = m.adj_pairs[e];
+      const bool is_a = m.pair_a[q] == i;
+      const uint32_t j = is_a ? m.pair_b[q] : m.pair_a[q];
+      const Vec3 d = s.x[j] - s.x[i];
+      const double r = d.norm();
+      if (r <= 0) continue;
+      const Vec3 xh = d / r;                                // x^_ij
+      const double c0 = is_a ? m.cos_a[q] : -m.cos_b[q];    // cos theta0_ij against x_ij
+      const double s0 = std::sqrt(std::max(0.0, 1 - c0 * c0));
+      Vec3 perp = ti - ti.dot(xh) * xh;
+      const double pn = perp.norm();
+      // t_i^j: x^_ij rotated by theta0_ij about the axis normal to t_i and x_ij (Fig. 3.3 c).
+      const Vec3 tij = pn > 1e-12 ? Vec3(c0 * xh + s0 * perp / pn) : Vec3(c0 * xh);
+      acc += ws.alpha[q] * ws.k[q] * tij;  // (3.15)
+    }
+    const double an = acc.norm();
+    if (an > 1e-300 && std::isfinite(an)) s.t[i] = acc / an;
+  });
+}
+
+LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpState& s,
+                              LcpWorkspace& ws) const {
+  LcpStepReport rep;
+  const auto& m = m_model;
+  const std::size_t n = m.size();
+  if (s.x.size() != n || s.v.size() != n || s.t.size() != n) {
+    rep.ok = false;
+    rep.message = fmt::format("state has {} particles, model {}", s.x.size(), n);
+    return rep;
+  }
+  if (!(in.dt > 0) || !std::isfinite(in.dt)) {
+    rep.ok = false;
+    rep.message = fmt::format("time step {} must be > 0", in.dt);
+    return rep;
+  }
+  if (in.external_force && in.external_force->size() != n) {
+    rep.ok = false;
+    rep.message = "external force array size differs from the particle count";
+    return rep;
+  }
+  const double dt = in.dt / m_params.substeps;
+  const anim::RigidSample& hd = in.head;
+  const Mat3 R = hd.rotation, Rt = R.transpose();
+  const Vec3 g_h = Rt * m_params.gravity;
+  // Inertial (fictitious) accelerations of the head frame, in head coordinates.
+  const Vec3 A_h = Rt * hd.acceleration, w_h = Rt * hd.angular_velocity,
+             al_h = Rt * hd.angular_acceleration, V_h = Rt * hd.velocity;
+  const Vec3 piv = hd.pivot;
+  ws.accel.resize(n);
+  std::vector<uint8_t> contact(n, 0);
+  std::vector<double> pen(n, 0.0);
+  for (int sub = 0; sub < m_params.substeps; ++sub) {
+    if (m_params.hair_hair) {
+      neighbours_and_density(ctx, s, ws);
+    } else {
+      ws.nbr_offsets.clear();
+    }
+    solve_alpha(ctx, s, ws);
+    pair_forces(ctx, s, ws);
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      if (m.root[i]) {
+        ws.accel[i] = Vec3::Zero();
+        return;
+      }
+      const double mi = m.mass[i];
+      const Vec3 r = s.x[i] - piv;  // head-frame lever arm about the pivot
+      Vec3 a = ws.force[i] / mi + g_h;
+      // Inertial forces due to head movement (§3.6).
+      a -= A_h + al_h.cross(r) + w_h.cross(w_h.cross(r)) + 2.0 * w_h.cross(s.v[i]);
+      // Air friction against still air: world velocity = V + omega x r + v.
+      a -= m_params.air_drag * (V_h + w_h.cross(r) + s.v[i]);
+      if (in.external_force) a += Rt * (*in.external_force)[i] / mi;
+      uint8_t c = 0;
+      double pdepth = 0;
+      if (m_params.body_collision && m_body) {
+        if (const sim::BodyPlane* pl = m_body->find(s.x[i])) {
+          const Vec3 ac = sim::body_contact_accel(*pl, s.x[i], s.v[i], a, dt, m_params.contact);
+          if (ac.squaredNorm() > 0) c = 1;
+          a += ac;
+          pdepth = std::max(0.0, -(s.x[i] - pl->p).dot(pl->n));
+        }
+      }
+      contact[i] = c;
+      pen[i] = pdepth;
+      ws.accel[i] = a;
+    });
+    // Leapfrog: v(t + dt/2) = v(t - dt/2) + a(t) dt, x(t + dt) = x(t) + v(t + dt/2) dt.
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      if (m.root[i]) {
+        s.x[i] = m.rest_x[i];
+        s.v[i] = Vec3::Zero();
+        return;
+      }
+      s.v[i] += ws.accel[i] * dt;
+      s.x[i] += s.v[i] * dt;
+    });
+    update_directions(ctx, s, ws);
+    s.time += dt;
+    rep.substeps = sub + 1;
+    // Blow-up detection: first non-finite or too fast particle, in index order.
+    struct Chk {
+      double vmax = 0;
+      std::size_t bad = SIZE_MAX;
+    };
+    const double vlim = m_params.max_speed;
+    const Chk chk = deterministic_reduce(
+        ctx, n, 1024, Chk{},
+        [&](std::size_t i0, std::size_t i1) {
+          Chk c;
+          for (std::size_t i = i0; i < i1; ++i) {
+            const double sp = s.v[i].norm();
+            const bool bad = !std::isfinite(sp) || !s.x[i].allFinite() || !s.t[i].allFinite() ||
+                             sp > vlim;
+            if (bad && c.bad == SIZE_MAX) c.bad = i;
+            if (std::isfinite(sp)) c.vmax = std::max(c.vmax, sp);
+          }
+          return c;
+        },
+        [](Chk acc, const Chk& part) {
+          acc.vmax = std::max(acc.vmax, part.vmax);
+          if (acc.bad == SIZE_MAX) acc.bad = part.bad;
+          return acc;
+        });
+    rep.max_speed = chk.vmax;
+    if (chk.bad != SIZE_MAX) {
+      rep.ok = false;
+      rep.bad_particle = chk.bad;
+      rep.message = fmt::format(
+          "blow-up at t = {:.5f} s: particle {} has speed {} m/s (limit {} m/s) or a non-finite "
+          "value; reduce the time step or the stiffness",
+          s.time, chk.bad, s.v[chk.bad].norm(), vlim);
+      return rep;
+    }
+  }
+  rep.num_contacts = std::size_t(std::count(contact.begin(), contact.end(), uint8_t(1)));
+  for (double d : pen) rep.max_penetration = std::max(rep.max_penetration, d);
+  return rep;
+}
+
+void lcp_world(const LcpState& s, const anim::RigidSample& hd, std::vector<Vec3>* x,
+               std::vector<Vec3>* v, std::vector<Vec3>* t) {
+  const std::size_t n = s.x.size();
+  if (x) x->resize(n);
+  if (v) v->resize(n);
+  if (t) t->resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 X = hd.apply(s.x[i]);
+    if (x) (*x)[i] = X;
+    if (v) (*v)[i] = hd.point_velocity(X) + hd.rotation * s.v[i];
+    if (t) (*t)[i] = hd.rotation * s.t[i];
+  }
+}
+
+}  // namespace follicle::hair

@@ -1,0 +1,229 @@
+#pragma once
+// Loosely connected particles (Bando, Chen & Nishita 2003; thesis ch. 3): hair as unordered
+// particles sampling the hair volume, loose springs between initially aligned neighbours with a
+// constant tensile modulus, SPH-style hair-hair interaction and voxel-plane hair-body collision.
+//
+// Frames: particles are simulated in the HEAD (rest) frame; the head moves rigidly by an
+// anim::RigidSample given per step, which adds the inertial forces of §3.6 (the paper simulates
+// in the head frame too: "inertia force due to head movement"). Root particles (s < 0) and the
+// body's voxel planes stay fixed in that frame. world_positions() maps the state to the world.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "follicle/anim/rigid_motion.hpp"
+#include "follicle/core/context.hpp"
+#include "follicle/core/params.hpp"
+#include "follicle/core/types.hpp"
+#include "follicle/hair/particle_grid.hpp"
+#include "follicle/hair/scalp_bando2003.hpp"
+#include "follicle/sim/voxel_planes.hpp"
+
+namespace follicle::hair {
+
+/// Particle initialisation and connections (§3.3.1).
+struct LcpInitParams {
+  double spacing = 0.012;        // r [m]: Poisson-disc radius under the distance (3.2)
+  int max_particles = 200000;    // hard cap on the number of particles
+  int attempts_per_particle = 40;  // dart throwing stops after this many misses per particle
+  Vec3 whirl_point{0, 1, 0};     // [m] head frame; the nearest scalp vertex is the whirl
+  double w_t = 1.0;              // (3.4) weight of the tangential root direction
+  double w_n = 0.6;              // (3.4) weight of the normal root direction
+  double hs_factor = 1.25;       // h_s = hs_factor * mean nearest-neighbour distance
+  double h_factor = 0.8;         // h = h_factor * mean nearest-neighbour distance
+  double a0 = 0.5;               // minimum alignment a_ij (3.6) of a connection
+  int n_n = 12;                  // N_n: about this many connections per particle
+  double total_mass = 0.05;      // [kg] hair mass shared equally by the particles
+  Vec3 gravity_dir{0, -1, 0};    // head-frame direction of gravity for the cantilever shape
+  double cantilever_sag = 800;   // w/(EI) [1/m^3]: load over bending stiffness of the beam
+  int cantilever_segments = 24;  // segments of the cantilever chain per strand
+  double body_clearance = 0.004; // [m] the initial chain keeps this far from the body planes
+  template <class V>
+  void visit(V&& v) {
+    v("spacing", spacing, ParamInfo{"Poisson-disc radius of (3.2)", "m", 1e-4, 1.0});
+    v("max_particles", max_particles, ParamInfo{"particle cap", "", 1, 1e8});
+    v("attempts_per_particle", attempts_per_particle, ParamInfo{"dart misses", "", 1, 1e5});
+    v("whirl_point", whirl_point, ParamInfo{"whirl of hair (head frame)", "m", -100, 100});
+    v("w_t", w_t, ParamInfo{"tangent weight of (3.4)", "", -100, 100});
+    v("w_n", w_n, ParamInfo{"normal weight of (3.4)", "", -100, 100});
+    v("hs_factor", hs_factor, ParamInfo{"h_s / mean spacing", "", 0.1, 10});
+    v("h_factor", h_factor, ParamInfo{"h / mean spacing", "", 0.1, 10});
+    v("a0", a0, ParamInfo{"alignment threshold a_0", "", 0.0, 1.0});
+    v("n_n", n_n, ParamInfo{"connections per particle N_n", "", 1, 1000});
+    v("total_mass", total_mass, ParamInfo{"hair mass", "kg", 1e-9, 100});
+    v("gravity_dir", gravity_dir, ParamInfo{"gravity direction for the initial shape", "", -1, 1});
+    v("cantilever_sag", cantilever_sag, ParamInfo{"w/(EI) of the cantilever", "1/m^3", 0, 1e9});
+    v("cantilever_segments", cantilever_segments, ParamInfo{"chain segments", "", 1, 10000});
+    v("body_clearance", body_clearance, ParamInfo{"initial distance from the body", "m", 0, 1});
+  }
+  void validate() const;
+};
+
+/// Dynamics (§3.3.2, §3.3.3, §3.5, §3.6).
+struct LcpParams {
+  int substeps = 4;                 // sub-steps per step() (fixed dt = step dt / substeps)
+  Vec3 gravity{0, -9.81, 0};        // [m/s^2] world frame
+  double air_drag = 0.6;            // [1/s] drag per unit mass against still air
+  double elastic_modulus = 4000;    // E [Pa] of (3.10)/(3.11), kept constant per particle
+  double material_density = 1300;   // delta [kg/m^3] of (3.9)
+  double spring_damping = 0.5;      // damping ratio of each loose spring
+  double compression_scale = 0.25;  // scales compressed springs: bending vs tensile stiffness
+  int alpha_sweeps = 0;             // balancing sweeps after (3.14) (0 = the paper: average only)
+  bool hair_hair = true;            // §3.3.3 on/off (Fig. 3.7 c vs d)
+  double k_a = 0.5;                 // [m^2/s^2] (3.16) pressure constant, P = k_a (rho - rho0)
+  double rho0_scale = 1.0;          // rho0 = rho0_scale * mean rest density (< 1 repulsive)
+  double collision_damping = 40;    // d_c of (3.17), per reduced mass [1/s] (see .cpp)
+  double friction_damping = 4;      // d_f of (3.18), per reduced mass [1/s]
+  double colinear_eps = 0.2;        // |t_i x t_j| below this: near-colinear collision direction
+  bool body_collision = true;       // §3.5 on/off (needs voxel planes)
+  sim::BodyContactParams contact;   // (3.19)-(3.24)
+  double max_speed = 30;            // [m/s] a faster particle is reported as a blow-up
+  template <class V>
+  void visit(V&& v) {
+    v("substeps", substeps, ParamInfo{"sub-steps per step", "", 1, 10000});
+    v("gravity", gravity, ParamInfo{"gravity", "m/s^2", -1000, 1000});
+    v("air_drag", air_drag, ParamInfo{"air drag per unit mass", "1/s", 0, 1e6});
+    v("elastic_modulus", elastic_modulus, ParamInfo{"tensile modulus E", "Pa", 1e-6, 1e12});
+    v("material_density", material_density, ParamInfo{"hair material density", "kg/m^3", 1, 1e5});
+    v("spring_damping", spring_damping, ParamInfo{"spring damping ratio", "", 0, 100});
+    v("compression_scale", compression_scale, ParamInfo{"compressed spring scale", "", 0, 10});
+    v("alpha_sweeps", alpha_sweeps, ParamInfo{"alpha balancing sweeps", "", 0, 100});
+    v("hair_hair", hair_hair, ParamInfo{"hair-hair interaction"});
+    v("k_a", k_a, ParamInfo{"pressure constant k_a", "m^2/s^2", 0, 1e6});
+    v("rho0_scale", rho0_scale, ParamInfo{"rest density rho0 / mean rest density", "", 0, 100});
+    v("collision_damping", collision_damping, ParamInfo{"collision damping d_c", "1/s", 0, 1e6});
+    v("friction_damping", friction_damping, ParamInfo{"friction damping d_f", "1/s", 0, 1e6});
+    v("colinear_eps", colinear_eps, ParamInfo{"near-colinear threshold", "", 0, 1});
+    v("body_collision", body_collision, ParamInfo{"hair-body collision"});
+    v("contact", contact);
+    v("max_speed", max_speed, ParamInfo{"blow-up speed", "m/s", 1e-3, 1e9});
+  }
+  void validate() const;
+};
+
+/// Constant per-particle data and the fixed connections.
+struct LcpModel {
+  std::vector<Vec3> uvs;          // (u_i, v_i, s_i)
+  std::vector<double> mass;       // m_i [kg]
+  std::vector<uint8_t> root;      // 1 = root particle (s < 0): fixed to the head
+  std::vector<Vec3> rest_x;       // initial positions (head frame) [m]
+  std::vector<Vec3> rest_t;       // initial hair directions, unit
+  // Connections, each oriented from its root-side particle a to its tip-side particle b, so
+  // b is in N_t(a) and a in N_r(b) (Fig. 3.3 a).
+  std::vector<uint32_t> pair_a, pair_b;
+  std::vector<double> l0;         // l0_ij [m]
+  std::vector<double> c;          // c_ij = a_ij l0_ij (3.5)
+  std::vector<double> cos_a, cos_b;  // cos(theta0) of t_a and t_b against x_ab (both > 0)
+  std::vector<uint32_t> adj_offsets, adj_pairs;  // particle -> its connections (CSR)
+  double spacing = 0;             // mean nearest-neighbour distance [m]
+  double h_s = 0;                 // smoothing length of the connections [m]
+  double h = 0;                   // smoothing length of hair-hair interaction [m]
+  double rest_density = 0;        // mean SPH density (3.1) of non-root particles at rest
+
+  std::size_t size() const { return mass.size(); }
+  std::size_t num_pairs() const { return l0.size(); }
+};
+
+struct LcpState {
+  std::vector<Vec3> x;  // head frame [m]
+  std::vector<Vec3> v;  // head frame [m/s] (leapfrog: half a sub-step behind x)
+  std::vector<Vec3> t;  // unit hair directions
+  double time = 0;
+};
+
+/// What step() reports (the simulation never throws on divergence).
+struct LcpStepReport {
+  bool ok = true;
+  std::string message;              // why not ok
+  std::size_t bad_particle = 0;     // first offending particle when !ok
+  int substeps = 0;                 // sub-steps taken
+  double max_speed = 0;             // [m/s] head frame, at the end
+  double max_penetration = 0;       // [m] deepest particle below a body plane (>= 0)
+  std::size_t num_contacts = 0;     // particles in contact at the last sub-step
+};
+
+struct LcpStepInput {
+  double dt = 1.0 / 60.0;                   // [s] split into params.substeps
+  anim::RigidSample head;                   // head/body pose and motion (world)
+  const std::vector<Vec3>* external_force = nullptr;  // [N] world frame per particle (wind)
+};
+
+/// Scratch buffers of a solver (reused between steps; not part of the physical state).
+struct LcpWorkspace {
+  ParticleGrid grid;
+  std::vector<uint32_t> nbr_offsets, nbrs;   // current neighbours within 2h
+  std::vector<double> density, pressure;     // (3.1), P = k_a (rho - rho0)
+  std::vector<double> k;                     // k_ij (3.7) per connection
+  std::vector<double> alpha;                 // alpha_ij (3.14) per connection
+  std::vector<double> alpha_r, alpha_t;      // (3.13) per particle
+  std::vector<Vec3> force;                   // [N] head frame
+  std::vector<Vec3> accel;
+};
+
+/// Builds the connections (§3.3.1, (3.5)-(3.6), pruning by a0 and N_n) for given particles.
+/// Also used by tests on lattices. Throws follicle::Error on size mismatches or bad values.
+LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
+                           const std::vector<Vec3>& t, const std::vector<Vec3>& uvs,
+                           const std::vector<double>& mass, const LcpInitParams& p);
+
+struct LcpInit {
+  LcpModel model;
+  LcpState state;
+};
+
+/// Poisson-disc sampling of the (u, v, s) pillar with (3.2), root directions (3.4), mapping
+/// back (3.3) along a cantilever-beam shape, and connections. `body` (optional, head frame)
+/// keeps the initial chains outside the body. Deterministic for ctx.seed().
+LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitParams& p,
+                       const sim::VoxelPlanes* body = nullptr);
+
+/// (3.4) root direction t_r(u, v) (not normalised) for the whirl normal n_w.
+Vec3 root_direction(const Vec3& n_w, const Vec3& n, double w_t, double w_n);
+
+/// (3.1) SPH density of every point with Monaghan's kernel, smoothing length h.
+std::vector<double> sph_density(const Context& ctx, const std::vector<Vec3>& x,
+                                const std::vector<double>& mass, double h);
+
+class LcpSolver {
+ public:
+  /// Validates params and the model. `body` (head frame) may be null; it must outlive the solver.
+  LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPlanes* body = nullptr);
+
+  /// Advances `state` by in.dt in params.substeps leapfrog sub-steps. NaN or runaway speed stops
+  /// the step and is reported (state then holds the last sub-step).
+  LcpStepReport step(const Context& ctx, const LcpStepInput& in, LcpState& state,
+                     LcpWorkspace& ws) const;
+
+  /// The initial state (rest positions and directions, zero velocity).
+  LcpState rest_state() const;
+
+  // Pieces of a sub-step, public for tests and tools.
+  /// k_ij (3.7) and the alpha solve (3.12)-(3.14) into ws.k / ws.alpha.
+  void solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  /// E_{r,i} and E_{t,i} of (3.10)/(3.11) from ws.k/ws.alpha (0 where the group is empty).
+  void tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
+                      std::vector<double>& e_t) const;
+  /// Internal pair forces only (springs, hair-hair) into ws.force [N]; no gravity/body.
+  void pair_forces(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  /// (3.15) new hair directions from ws.alpha/ws.k and the current positions.
+  void update_directions(const Context& ctx, LcpState& s, const LcpWorkspace& ws) const;
+  /// A_i of (3.9).
+  double cross_section(std::size_t i) const;
+
+  const LcpModel& model() const { return m_model; }
+  const LcpParams& params() const { return m_params; }
+  double rho0() const { return m_rho0; }
+
+ private:
+  void neighbours_and_density(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  LcpParams m_params;
+  LcpModel m_model;
+  const sim::VoxelPlanes* m_body = nullptr;
+  double m_rho0 = 0;
+};
+
+/// World positions (and optionally velocities, directions) of the particles for a head sample.
+void lcp_world(const LcpState& s, const anim::RigidSample& head, std::vector<Vec3>* x,
+               std::vector<Vec3>* v = nullptr, std::vector<Vec3>* t = nullptr);
+
+}  // namespace follicle::hair

@@ -1,0 +1,82 @@
+#include "follicle/hair/particle_grid.hpp"
+
+#include "follicle/core/error.hpp"
+#include "follicle/core/parallel.hpp"
+
+namespace follicle::hair {
+
+void ParticleGrid::build(const std::vector<Vec3>& points, double cell) {
+  if (!(cell > 0) || !std::isfinite(cell)) fail("particle grid: cell size {} must be > 0", cell);
+  m_inv = 1.0 / cell;
+  std::size_t nb = 64;
+  while (nb < 2 * points.size()) nb *= 2;
+  m_mask = uint32_t(nb - 1);
+  m_start.assign(nb + 1, 0);
+  m_bucket_of.resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    const uint32_t b = bucket(int(std::floor(p.x() * m_inv)), int(std::floor(p.y() * m_inv)),
+                              int(std::floor(p.z() * m_inv)));
+    m_bucket_of[i] = b;
+    ++m_start[b + 1];
+  }
+  for (std::size_t b = 0; b < nb; ++b) m_start[b + 1] += m_start[b];
+  m_sorted.resize(points.size());
+  std::vector<uint32_t> fill(m_start.begin(), m_start.end() - 1);
+  for (std::size_t i = 0; i < points.size(); ++i) m_sorted[fill[m_bucket_of[i]]++] = uint32_t(i);
+}
+
+namespace {
+template <class Search>
+void build_lists(const Context& ctx, std::size_t n, std::vector<uint32_t>& offsets,
+                 std::vector<uint32_t>& nbrs, Search&& search) {
+  constexpr std::size_t kChunk = 512;
+  const std::size_t nchunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<uint32_t>> parts(nchunks);
+  offsets.assign(n + 1, 0);
+  parallel_for(
+      ctx, 0, nchunks,
+      [&](std::size_t c) {
+        auto& out = parts[c];
+        out.clear();
+        const std::size_t e = std::min(n, (c + 1) * kChunk);
+        for (std::size_t i = c * kChunk; i < e; ++i) {
+          const std::size_t before = out.size();
+          search(i, out);
+          offsets[i + 1] = uint32_t(out.size() - before);
+        }
+      },
+      1);
+  for (std::size_t i = 0; i < n; ++i) offsets[i + 1] += offsets[i];
+  nbrs.resize(offsets[n]);
+  for (std::size_t c = 0; c < nchunks; ++c)
+    std::copy(parts[c].begin(), parts[c].end(), nbrs.begin() + offsets[c * kChunk]);
+}
+}  // namespace
+
+void ParticleGrid::neighbour_lists(const Context& ctx, const std::vector<Vec3>& points,
+                                   double radius, std::vector<uint32_t>& offsets,
+                                   std::vector<uint32_t>& nbrs) const {
+  const double r2 = radius * radius;
+  build_lists(ctx, points.size(), offsets, nbrs, [&](std::size_t i, std::vector<uint32_t>& out) {
+    const Vec3& p = points[i];
+    for_each_candidate(p, [&](uint32_t j) {
+      if (j != i && (points[j] - p).squaredNorm() < r2) out.push_back(j);
+    });
+  });
+}
+
+void ParticleGrid::cross_lists(const Context& ctx, const std::vector<Vec3>& queries,
+                               const std::vector<Vec3>& grid_points, double radius,
+                               std::vector<uint32_t>& offsets,
+                               std::vector<uint32_t>& nbrs) const {
+  const double r2 = radius * radius;
+  build_lists(ctx, queries.size(), offsets, nbrs, [&](std::size_t i, std::vector<uint32_t>& out) {
+    const Vec3& p = queries[i];
+    for_each_candidate(p, [&](uint32_t j) {
+      if ((grid_points[j] - p).squaredNorm() < r2) out.push_back(j);
+    });
+  });
+}
+
+}  // namespace follicle::hair

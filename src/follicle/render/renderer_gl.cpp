@@ -1,0 +1,880 @@
+// The OpenGL 3.3 core renderer: shadow pass (first shadow-casting light, orthographic depth map
+// over meshes and strands), main pass into a k-times supersampled RGBA16F FBO (meshes, strands,
+// particles), then a resolve pass that box-filters k x k samples in linear space and encodes
+// sRGB into an RGBA8 FBO that is read back. All geometry goes up once per render in VBOs; every
+// item is one draw call.
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <spdlog/spdlog.h>
+
+#include "follicle/render/camera.hpp"
+#include "follicle/render/egl_context.hpp"
+#include "follicle/render/renderer.hpp"
+#include "follicle/render/shaders_gl.hpp"
+
+namespace follicle::render {
+namespace {
+
+constexpr int kMaxLights = 8;
+constexpr int kMaxLobes = 4;
+
+GLuint compile(GLenum type, const std::string& src, const char* name) {
+  GLuint s = glCreateShader(type);
+  const char* p = src.c_str();
+  glShaderSource(s, 1, &p, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {0};
+    glGetShaderInfoLog(s, sizeof(log) - 1, nullptr, log);
+    glDeleteShader(s);
+    fail("render: cannot compile shader {}: {}", name, log);
+  }
+  return s;
+}
+
+GLuint link_program(const char* name, const std::string& defines, const char* vs, const char* fs,
+                    const char* gs = nullptr, bool lights = false) {
+  const std::string head = std::string("#version 330 core\n") + defines;
+  const std::string lb = lights ? glsl::kLightsBlock : "";
+  GLuint v = compile(GL_VERTEX_SHADER, head + vs, name);
+  GLuint f = compile(GL_FRAGMENT_SHADER, head + lb + fs, name);
+  GLuint g = gs ? compile(GL_GEOMETRY_SHADER, head + gs, name) : 0;
+  GLuint p = glCreateProgram();
+  glAttachShader(p, v);
+  glAttachShader(p, f);
+  if (g) glAttachShader(p, g);
+  glLinkProgram(p);
+  glDeleteShader(v);
+  glDeleteShader(f);
+  if (g) glDeleteShader(g);
+  GLint ok = 0;
+  glGetProgramiv(p, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {0};
+    glGetProgramInfoLog(p, sizeof(log) - 1, nullptr, log);
+    glDeleteProgram(p);
+    fail("render: cannot link shader program {}: {}", name, log);
+  }
+  return p;
+}
+
+Eigen::Matrix4f to_f(const Mat4& m) { return m.cast<float>(); }
+
+void set_mat4(GLuint p, const char* n, const Mat4& m) {
+  const Eigen::Matrix4f f = to_f(m);  // Eigen is column-major like GL
+  glUniformMatrix4fv(glGetUniformLocation(p, n), 1, GL_FALSE, f.data());
+}
+void set_mat3(GLuint p, const char* n, const Mat3& m) {
+  const Eigen::Matrix3f f = m.cast<float>();
+  glUniformMatrix3fv(glGetUniformLocation(p, n), 1, GL_FALSE, f.data());
+}
+void set_vec3(GLuint p, const char* n, const Vec3& v) {
+  glUniform3f(glGetUniformLocation(p, n), float(v.x()), float(v.y()), float(v.z()));
+}
+void set_f(GLuint p, const char* n, double v) { glUniform1f(glGetUniformLocation(p, n), float(v)); }
+void set_i(GLuint p, const char* n, int v) { glUniform1i(glGetUniformLocation(p, n), v); }
+
+/// GL objects created for one render() and deleted at its end.
+struct FrameObjects {
+  std::vector<GLuint> buffers, vaos, textures;
+  ~FrameObjects() {
+    if (!buffers.empty()) glDeleteBuffers(GLsizei(buffers.size()), buffers.data());
+    if (!vaos.empty()) glDeleteVertexArrays(GLsizei(vaos.size()), vaos.data());
+    if (!textures.empty()) glDeleteTextures(GLsizei(textures.size()), textures.data());
+  }
+  GLuint buffer(GLenum target, std::size_t bytes, const void* data) {
+    GLuint b = 0;
+    glGenBuffers(1, &b);
+    buffers.push_back(b);
+    glBindBuffer(target, b);
+    glBufferData(target, GLsizeiptr(bytes), data, GL_STATIC_DRAW);
+    return b;
+  }
+  GLuint vao() {
+    GLuint a = 0;
+    glGenVertexArrays(1, &a);
+    vaos.push_back(a);
+    glBindVertexArray(a);
+    return a;
+  }
+};
+
+void attrib(GLuint loc, int comps, std::size_t stride, std::size_t offset, GLuint divisor = 0) {
+  glEnableVertexAttribArray(loc);
+  glVertexAttribPointer(loc, comps, GL_FLOAT, GL_FALSE, GLsizei(stride),
+                        reinterpret_cast<const void*>(offset));
+  glVertexAttribDivisor(loc, divisor);
+}
+
+struct MeshVertex {
+  float pos[3], normal[3], uv[2], color[3], pu[3], pv[3];
+};
+struct StrandVertex {
+  float pos[3], color[3], tangent[3], radius;
+};
+struct ParticleInstance {
+  float pos[3], color[3], radius, opacity, dir[3];
+};
+
+struct MeshDraw {
+  GLuint vao = 0;
+  GLsizei count = 0;
+  const MeshItem* item = nullptr;
+  bool has_uvs = false;
+};
+struct StrandDraw {
+  GLuint vao = 0;
+  std::vector<GLint> first;
+  std::vector<GLsizei> count;
+  const StrandItem* item = nullptr;
+  bool ribbons = false;
+};
+struct ParticleDraw {
+  GLuint vao = 0;
+  GLsizei count = 0;
+  const ParticleItem* item = nullptr;
+  bool blend = false;
+};
+
+double linear_scale(const Affine3& xf) { return std::cbrt(std::abs(xf.linear().determinant())); }
+
+void extend(Eigen::AlignedBox3d& box, const Affine3& xf, const Vec3& p) { box.extend(xf * p); }
+
+/// Builds the unwelded per-corner vertex array of a mesh. Normals: the mesh's own, else
+/// area-weighted face normals. Pu, Pv (dP/du, dP/dv) are averaged per UV vertex so the tangent
+/// frame is smooth within a UV chart.
+std::vector<MeshVertex> build_mesh_vertices(const MeshItem& item, std::size_t index,
+                                            Eigen::AlignedBox3d* shadow_box) {
+  const geom::TriMesh& m = *item.mesh;
+  const std::string where = fmt::format("render: meshes[{}] '{}'", index, m.name);
+  const std::size_t nv = m.positions.size();
+  const bool vcol = !item.vertex_colors.empty();
+  if (vcol && item.vertex_colors.size() != nv)
+    fail_at(where, "{} vertex colours for {} vertices", item.vertex_colors.size(), nv);
+  const bool uvs = !m.uvs.empty();
+  if (uvs && m.uv_faces.size() != m.faces.size())
+    fail_at(where, "{} UV faces for {} faces", m.uv_faces.size(), m.faces.size());
+  for (std::size_t f = 0; f < m.faces.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      if (m.faces[f][k] < 0 || std::size_t(m.faces[f][k]) >= nv)
+        fail_at(where, "face {} has vertex index {} out of range [0, {})", f, m.faces[f][k], nv);
+      if (uvs && (m.uv_faces[f][k] < 0 || std::size_t(m.uv_faces[f][k]) >= m.uvs.size()))
+        fail_at(where, "face {} has UV index {} out of range [0, {})", f, m.uv_faces[f][k],
+                m.uvs.size());
+    }
+  }
+  std::vector<Vec3> normals;
+  if (m.normals.size() == nv) {
+    normals = m.normals;
+  } else {
+    normals.assign(nv, Vec3::Zero());
+    for (const Vec3i& f : m.faces) {
+      const Vec3 n = (m.positions[std::size_t(f[1])] - m.positions[std::size_t(f[0])])
+                         .cross(m.positions[std::size_t(f[2])] - m.positions[std::size_t(f[0])]);
+      for (int k = 0; k < 3; ++k) normals[std::size_t(f[k])] += n;  // |n| = 2 * area
+    }
+  }
+  std::vector<Vec3> pu, pv;
+  if (uvs) {
+    pu.assign(m.uvs.size(), Vec3::Zero());
+    pv.assign(m.uvs.size(), Vec3::Zero());
+    for (std::size_t f = 0; f < m.faces.size(); ++f) {
+      const Vec3& p0 = m.positions[std::size_t(m.faces[f][0])];
+      const Vec3 e1 = m.positions[std::size_t(m.faces[f][1])] - p0;
+      const Vec3 e2 = m.positions[std::size_t(m.faces[f][2])] - p0;
+      const Vec2& t0 = m.uvs[std::size_t(m.uv_faces[f][0])];
+      const Vec2 d1 = m.uvs[std::size_t(m.uv_faces[f][1])] - t0;
+      const Vec2 d2 = m.uvs[std::size_t(m.uv_faces[f][2])] - t0;
+      const double det = d1.x() * d2.y() - d2.x() * d1.y();
+      if (std::abs(det) < 1e-14) continue;
+      // [e1 e2] = [Pu Pv] [d1 d2]  =>  [Pu Pv] = [e1 e2] [d1 d2]^-1
+      const Vec3 fu = (e1 * d2.y() - e2 * d1.y()) / det;
+      const Vec3 fv = (e2 * d1.x() - e1 * d2.x()) / det;
+      for (int k = 0; k < 3; ++k) {
+        pu[std::size_t(m.uv_faces[f][k])] += fu;
+        pv[std::size_t(m.uv_faces[f][k])] += fv;
+      }
+    }
+    // Averages, not sums: the magnitude matters for bump mapping.
+    std::vector<int> cnt(m.uvs.size(), 0);
+    for (std::size_t f = 0; f < m.faces.size(); ++f)
+      for (int k = 0; k < 3; ++k) ++cnt[std::size_t(m.uv_faces[f][k])];
+    for (std::size_t i = 0; i < cnt.size(); ++i)
+      if (cnt[i] > 0) {
+        pu[i] /= cnt[i];
+        pv[i] /= cnt[i];
+      }
+  }
+  std::vector<MeshVertex> out(m.faces.size() * 3);
+  for (std::size_t f = 0; f < m.faces.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t vi = std::size_t(m.faces[f][k]);
+      MeshVertex& v = out[f * 3 + std::size_t(k)];
+      const Vec3& p = m.positions[vi];
+      if (!p.allFinite()) fail_at(where, "vertex {} is not finite", vi);
+      if (shadow_box) extend(*shadow_box, item.transform, p);
+      Vec3 n = normals[vi];
+      n = n.norm() > 0 ? n.normalized() : Vec3(0, 0, 1);
+      const Vec3 c = vcol ? item.vertex_colors[vi].cast<double>() : Vec3(1, 1, 1);
+      Vec2 uv(0, 0);
+      Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+      if (uvs) {
+        const std::size_t ti = std::size_t(m.uv_faces[f][k]);
+        uv = m.uvs[ti];
+        a = pu[ti];
+        b = pv[ti];
+      }
+      for (int j = 0; j < 3; ++j) {
+        v.pos[j] = float(p[j]);
+        v.normal[j] = float(n[j]);
+        v.color[j] = float(c[j]);
+        v.pu[j] = float(a[j]);
+        v.pv[j] = float(b[j]);
+      }
+      v.uv[0] = float(uv.x());
+      v.uv[1] = float(uv.y());
+    }
+  }
+  return out;
+}
+
+class GlRenderer final : public Renderer {
+ public:
+  GlRenderer(const Context& ctx, std::unique_ptr<EglContext> egl)
+      : m_log(ctx.logger_ptr()), m_egl(std::move(egl)) {
+    if (m_egl) m_egl->make_current();
+    init();
+  }
+
+  ~GlRenderer() override {
+    try {
+      if (m_egl) m_egl->make_current();
+      for (GLuint p : {m_mesh_prog, m_line_prog, m_ribbon_prog, m_depth_prog, m_particle_prog,
+                       m_resolve_prog})
+        glDeleteProgram(p);
+      for (auto& [k, t] : m_tex_cache) glDeleteTextures(1, &t.tex);
+      release_targets();
+      glDeleteVertexArrays(1, &m_empty_vao);
+      glDeleteBuffers(1, &m_quad_vbo);
+    } catch (...) {  // destructors must not throw; the context may already be gone
+    }
+  }
+
+  std::string device_description() const override {
+    return m_description + (m_egl ? " [EGL " + m_egl->platform() + "]" : "");
+  }
+
+  image::ImageRGBA8 render(const RenderScene& scene, const RenderSettings& settings) override {
+    if (m_egl) m_egl->make_current();
+    draw(scene, settings);
+    image::ImageRGBA8 img(settings.width, settings.height);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, m_out_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, settings.width, settings.height, GL_RGBA, GL_UNSIGNED_BYTE, img.data());
+    check_gl("readback");
+    // GL rows run bottom-up; Image row 0 is the top.
+    const std::size_t row = std::size_t(settings.width) * 4;
+    std::vector<uint8_t> tmp(row);
+    for (int y = 0; y < settings.height / 2; ++y) {
+      uint8_t* a = img.data() + std::size_t(y) * row;
+      uint8_t* b = img.data() + std::size_t(settings.height - 1 - y) * row;
+      std::copy(a, a + row, tmp.data());
+      std::copy(b, b + row, a);
+      std::copy(tmp.data(), tmp.data() + row, b);
+    }
+    return img;
+  }
+
+  void render_to_framebuffer(const RenderScene& scene, const RenderSettings& settings,
+                             unsigned target_fbo) override {
+    if (m_egl) m_egl->make_current();
+    draw(scene, settings);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, m_out_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target_fbo);
+    glBlitFramebuffer(0, 0, settings.width, settings.height, 0, 0, settings.width,
+                      settings.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, target_fbo);
+    check_gl("blit to target framebuffer");
+  }
+
+ private:
+  void init() {
+    const char* ver = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+    const char* ren = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    if (!ver) fail("render: no current OpenGL context");
+    m_description = std::string(ver) + " / " + (ren ? ren : "?");
+    int major = 0, minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    if (major * 10 + minor < 33) fail("render: OpenGL 3.3 needed, got {}", m_description);
+    m_mesh_prog = link_program("mesh", "", glsl::kMeshVs, glsl::kMeshFs, nullptr, true);
+    m_line_prog = link_program("strand-lines", "", glsl::kStrandVs, glsl::kStrandFs, nullptr, true);
+    m_ribbon_prog = link_program("strand-ribbons", "#define RIBBONS\n", glsl::kStrandVs,
+                                 glsl::kStrandFs, glsl::kStrandGs, true);
+    m_depth_prog = link_program("depth", "", glsl::kDepthVs, glsl::kDepthFs);
+    m_particle_prog = link_program("particles", "", glsl::kParticleVs, glsl::kParticleFs);
+    m_resolve_prog = link_program("resolve", "", glsl::kResolveVs, glsl::kResolveFs);
+    glGenVertexArrays(1, &m_empty_vao);
+    const float quad[] = {-1, -1, 1, -1, -1, 1, 1, 1};
+    glGenBuffers(1, &m_quad_vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, m_quad_vbo);
+    glBufferData(GL_ARRAY_BUFFER, sizeof(quad), quad, GL_STATIC_DRAW);
+    glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, m_line_width_range);
+    check_gl("initialisation");
+    m_log->debug("render: {}", device_description());
+  }
+
+  void check_gl(const char* what) const {
+    const GLenum e = glGetError();
+    if (e != GL_NO_ERROR) fail("render: OpenGL error 0x{:x} during {}", unsigned(e), what);
+  }
+
+  void release_targets() {
+    if (m_fbo) glDeleteFramebuffers(1, &m_fbo);
+    if (m_color_tex) glDeleteTextures(1, &m_color_tex);
+    if (m_depth_rb) glDeleteRenderbuffers(1, &m_depth_rb);
+    if (m_out_fbo) glDeleteFramebuffers(1, &m_out_fbo);
+    if (m_out_rb) glDeleteRenderbuffers(1, &m_out_rb);
+    if (m_shadow_fbo) glDeleteFramebuffers(1, &m_shadow_fbo);
+    if (m_shadow_tex) glDeleteTextures(1, &m_shadow_tex);
+    m_fbo = m_color_tex = m_depth_rb = m_out_fbo = m_out_rb = m_shadow_fbo = m_shadow_tex = 0;
+    m_fb_w = m_fb_h = m_out_w = m_out_h = m_shadow_size = 0;
+  }
+
+  void ensure_targets(int w, int h, int k, int shadow_size) {
+    const int fw = w * k, fh = h * k;
+    GLint max_rb = 0, max_tex = 0;
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    const int lim = std::min(max_rb, max_tex);
+    if (fw > lim || fh > lim)
+      fail("render: {}x{} at supersample {} needs a {}x{} framebuffer; this GL allows {}", w, h,
+           k, fw, fh, lim);
+    if (shadow_size > max_tex)
+      fail("render: shadow_map_size {} exceeds GL_MAX_TEXTURE_SIZE {}", shadow_size, max_tex);
+    if (fw != m_fb_w || fh != m_fb_h || w != m_out_w || h != m_out_h) {
+      const int keep_shadow = m_shadow_size;
+      GLuint sfbo = m_shadow_fbo, stex = m_shadow_tex;
+      m_shadow_fbo = m_shadow_tex = 0;
+      release_targets();
+      m_shadow_fbo = sfbo;
+      m_shadow_tex = stex;
+      m_shadow_size = keep_shadow;
+      glGenTextures(1, &m_color_tex);
+      glBindTexture(GL_TEXTURE_2D, m_color_tex);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, fw, fh, 0, GL_RGBA, GL_FLOAT, nullptr);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+      glGenRenderbuffers(1, &m_depth_rb);
+      glBindRenderbuffer(GL_RENDERBUFFER, m_depth_rb);
+      glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, fw, fh);
+      glGenFramebuffers(1, &m_fbo);
+      glBindFramebuffer(GL_FRAMEBUFFER, m_fbo);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, m_color_tex, 0);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, m_depth_rb);
+      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        fail("render: the {}x{} RGBA16F framebuffer is incomplete", fw, fh);
+      glGenRenderbuffers(1, &m_out_rb);
+      glBindRenderbuffer(GL_RENDERBUFFER, m_out_rb);
+      glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+      glGenFramebuffers(1, &m_out_fbo);
+      glBindFramebuffer(GL_FRAMEBUFFER, m_out_fbo);
+      glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, m_out_rb);
+      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        fail("render: the {}x{} RGBA8 framebuffer is incomplete", w, h);
+      m_fb_w = fw;
+      m_fb_h = fh;
+      m_out_w = w;
+      m_out_h = h;
+    }
+    if (shadow_size != m_shadow_size) {
+      if (m_shadow_fbo) glDeleteFramebuffers(1, &m_shadow_fbo);
+      if (m_shadow_tex) glDeleteTextures(1, &m_shadow_tex);
+      glGenTextures(1, &m_shadow_tex);
+      glBindTexture(GL_TEXTURE_2D, m_shadow_tex);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, shadow_size, shadow_size, 0,
+                   GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, nullptr);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+      glGenFramebuffers(1, &m_shadow_fbo);
+      glBindFramebuffer(GL_FRAMEBUFFER, m_shadow_fbo);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, m_shadow_tex, 0);
+      glDrawBuffer(GL_NONE);
+      glReadBuffer(GL_NONE);
+      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        fail("render: the shadow framebuffer is incomplete");
+      m_shadow_size = shadow_size;
+    }
+    check_gl("framebuffer setup");
+  }
+
+  /// Textures are cached by image identity (shared_ptr<const Image> means the pixels are
+  /// immutable); an entry is dropped when its image has been destroyed.
+  template <class Img>
+  GLuint texture(const std::shared_ptr<const Img>& img, GLenum internal, GLenum format,
+                 GLenum type, bool mipmap) {
+    auto it = m_tex_cache.find(img.get());
+    if (it != m_tex_cache.end() && !it->second.owner.expired() &&
+        it->second.owner.lock().get() == static_cast<const void*>(img.get())) {
+      return it->second.tex;
+    }
+    if (it != m_tex_cache.end()) {
+      glDeleteTextures(1, &it->second.tex);
+      m_tex_cache.erase(it);
+    }
+    if (img->empty()) fail("render: empty texture image");
+    GLuint t = 0;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GLint(internal), img->width(), img->height(), 0, format, type,
+                 img->data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                    mipmap ? GL_LINEAR_MIPMAP_NEAREST : GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    if (mipmap) glGenerateMipmap(GL_TEXTURE_2D);
+    m_tex_cache[img.get()] = TexEntry{std::weak_ptr<const void>(img), t};
+    return t;
+  }
+
+  void purge_texture_cache() {
+    for (auto it = m_tex_cache.begin(); it != m_tex_cache.end();) {
+      if (it->second.owner.expired()) {
+        glDeleteTextures(1, &it->second.tex);
+        it = m_tex_cache.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+
+  void set_lights(GLuint p, const RenderScene& scene) {
+    const int n = int(std::min<std::size_t>(scene.lights.size(), kMaxLights));
+    set_i(p, "uNumLights", n);
+    for (int i = 0; i < n; ++i) {
+      const DirectionalLight& l = scene.lights[std::size_t(i)];
+      set_vec3(p, fmt::format("uLightDir[{}]", i).c_str(), -l.direction.normalized());
+      set_vec3(p, fmt::format("uLightColor[{}]", i).c_str(), l.color * l.intensity);
+    }
+    set_vec3(p, "uAmbientColor", scene.ambient_color);
+    set_vec3(p, "uEye", scene.camera.eye);
+  }
+
+  void draw(const RenderScene& scene, const RenderSettings& settings) {
+    settings.validate();
+    scene.camera.validate();
+    if (scene.lights.size() > std::size_t(kMaxLights))
+      fail_at("render.lights", "{} lights given, at most {} are supported", scene.lights.size(),
+              kMaxLights);
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+      const auto& l = scene.lights[i];
+      if (!l.direction.allFinite() || l.direction.norm() < 1e-12)
+        fail_at(fmt::format("render.lights[{}].direction", i), "must be a non-zero finite vector");
+      if (!l.color.allFinite() || !std::isfinite(l.intensity))
+        fail_at(fmt::format("render.lights[{}]", i), "colour and intensity must be finite");
+    }
+    const int k = settings.supersample;
+    ensure_targets(settings.width, settings.height, k, settings.shadow_map_size);
+    purge_texture_cache();
+    FrameObjects fo;
+
+    int shadow_light = -1;
+    for (std::size_t i = 0; i < scene.lights.size(); ++i)
+      if (scene.lights[i].cast_shadow) {
+        shadow_light = int(i);
+        break;
+      }
+    Eigen::AlignedBox3d shadow_box;
+    Eigen::AlignedBox3d* sb = shadow_light >= 0 ? &shadow_box : nullptr;
+
+    // ---- upload -------------------------------------------------------------------------------
+    std::vector<MeshDraw> meshes;
+    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+      const MeshItem& item = scene.meshes[i];
+      if (!item.mesh || item.mesh->faces.empty()) continue;
+      const auto verts = build_mesh_vertices(item, i, item.cast_shadow ? sb : nullptr);
+      MeshDraw d;
+      d.vao = fo.vao();
+      fo.buffer(GL_ARRAY_BUFFER, verts.size() * sizeof(MeshVertex), verts.data());
+      const std::size_t s = sizeof(MeshVertex);
+      attrib(0, 3, s, offsetof(MeshVertex, pos));
+      attrib(1, 3, s, offsetof(MeshVertex, normal));
+      attrib(2, 2, s, offsetof(MeshVertex, uv));
+      attrib(3, 3, s, offsetof(MeshVertex, color));
+      attrib(4, 3, s, offsetof(MeshVertex, pu));
+      attrib(5, 3, s, offsetof(MeshVertex, pv));
+      d.count = GLsizei(verts.size());
+      d.item = &item;
+      d.has_uvs = item.mesh->has_uvs();
+      meshes.push_back(d);
+    }
+    std::vector<StrandDraw> strands;
+    for (std::size_t i = 0; i < scene.strands.size(); ++i) {
+      const StrandItem& item = scene.strands[i];
+      if (!item.strands || item.strands->points.empty()) continue;
+      strands.push_back(upload_strands(fo, item, i, item.cast_shadow ? sb : nullptr));
+    }
+    const Mat4 view = view_matrix(scene.camera);
+    const Mat4 proj = projection_matrix(scene.camera, double(settings.width) / settings.height);
+    const Mat4 view_proj = proj * view;
+    std::vector<ParticleDraw> particles;
+    for (std::size_t i = 0; i < scene.particles.size(); ++i) {
+      const ParticleItem& item = scene.particles[i];
+      if (!item.particles || item.particles->positions.empty()) continue;
+      particles.push_back(upload_particles(fo, item, i, view));
+    }
+    check_gl("upload");
+
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+
+    // ---- shadow pass --------------------------------------------------------------------------
+    Mat4 light_vp = Mat4::Identity();
+    double shadow_texel_world = 0, shadow_depth_range = 1;
+    const bool shadows = shadow_light >= 0 && !shadow_box.isEmpty();
+    if (shadows) {
+      const Vec3 c = shadow_box.center();
+      const double r = std::max(0.5 * shadow_box.diagonal().norm(), 1e-6);
+      const Vec3 dir = scene.lights[std::size_t(shadow_light)].direction.normalized();
+      const Vec3 up = std::abs(dir.y()) < 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
+      const Mat4 lv = look_at(c - dir * (2 * r), c, up);
+      light_vp = orthographic(-r, r, -r, r, r * 0.5, r * 3.5) * lv;
+      shadow_texel_world = 2 * r / settings.shadow_map_size;
+      shadow_depth_range = 3 * r;
+      glBindFramebuffer(GL_FRAMEBUFFER, m_shadow_fbo);
+      glViewport(0, 0, settings.shadow_map_size, settings.shadow_map_size);
+      glClear(GL_DEPTH_BUFFER_BIT);
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.5f, 2.0f);
+      glUseProgram(m_depth_prog);
+      set_mat4(m_depth_prog, "uLightVP", light_vp);
+      for (const MeshDraw& d : meshes) {
+        if (!d.item->cast_shadow) continue;
+        set_mat4(m_depth_prog, "uModel", d.item->transform.matrix());
+        glBindVertexArray(d.vao);
+        glDrawArrays(GL_TRIANGLES, 0, d.count);
+      }
+      glDisable(GL_POLYGON_OFFSET_FILL);
+      glLineWidth(1.0f);
+      for (const StrandDraw& d : strands) {
+        if (!d.item->cast_shadow) continue;
+        set_mat4(m_depth_prog, "uModel", d.item->transform.matrix());
+        glBindVertexArray(d.vao);
+        glMultiDrawArrays(GL_LINE_STRIP, d.first.data(), d.count.data(), GLsizei(d.first.size()));
+      }
+      check_gl("shadow pass");
+    }
+
+    // ---- main pass ----------------------------------------------------------------------------
+    glBindFramebuffer(GL_FRAMEBUFFER, m_fbo);
+    glViewport(0, 0, m_fb_w, m_fb_h);
+    const Vec3 bg = scene.background;
+    if (settings.transparent_background)
+      glClearColor(0, 0, 0, 0);
+    else
+      glClearColor(float(bg.x()), float(bg.y()), float(bg.z()), 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+    if (!meshes.empty()) {
+      const GLuint p = m_mesh_prog;
+      glUseProgram(p);
+      set_mat4(p, "uViewProj", view_proj);
+      set_lights(p, scene);
+      set_i(p, "uAlbedoTex", 0);
+      set_i(p, "uHeightTex", 1);
+      set_i(p, "uNormalTex", 2);
+      set_i(p, "uShadowTex", 3);
+      glActiveTexture(GL_TEXTURE3);
+      glBindTexture(GL_TEXTURE_2D, m_shadow_tex);
+      set_i(p, "uShadowLight", shadows ? shadow_light : -1);
+      set_mat4(p, "uLightVP", light_vp);
+      set_f(p, "uShadowTexel", 1.0 / settings.shadow_map_size);
+      set_f(p, "uShadowNormalOffset", 1.5 * shadow_texel_world);
+      set_f(p, "uShadowBias", 1.0 * shadow_texel_world / shadow_depth_range);
+      for (const MeshDraw& d : meshes) draw_mesh(p, d);
+      check_gl("mesh pass");
+    }
+    if (!strands.empty()) draw_strands(scene, settings, strands, view_proj, proj);
+    if (!particles.empty()) {
+      const GLuint p = m_particle_prog;
+      glUseProgram(p);
+      set_mat4(p, "uView", view);
+      set_mat4(p, "uProj", proj);
+      glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+      for (const ParticleDraw& d : particles) {
+        set_mat4(p, "uModel", d.item->transform.matrix());
+        set_f(p, "uModelScale", linear_scale(d.item->transform));
+        set_i(p, "uShading", d.item->shading == ParticleShading::HairSplat ? 1 : 0);
+        const bool blend = d.blend || d.item->shading == ParticleShading::HairSplat;
+        if (blend) {
+          glEnable(GL_BLEND);
+          glDepthMask(GL_FALSE);
+        }
+        glBindVertexArray(d.vao);
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, d.count);
+        glDisable(GL_BLEND);
+        glDepthMask(GL_TRUE);
+      }
+      check_gl("particle pass");
+    }
+
+    // ---- resolve ------------------------------------------------------------------------------
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glBindFramebuffer(GL_FRAMEBUFFER, m_out_fbo);
+    glViewport(0, 0, settings.width, settings.height);
+    glUseProgram(m_resolve_prog);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, m_color_tex);
+    set_i(m_resolve_prog, "uSrc", 0);
+    set_i(m_resolve_prog, "uK", k);
+    set_i(m_resolve_prog, "uUnpremultiply", settings.transparent_background ? 1 : 0);
+    glBindVertexArray(m_empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    check_gl("resolve");
+  }
+
+  void draw_mesh(GLuint p, const MeshDraw& d) {
+    const MeshItem& item = *d.item;
+    const MeshMaterial& mat = item.material;
+    set_mat4(p, "uModel", item.transform.matrix());
+    set_mat3(p, "uNormalMat", item.transform.linear().inverse().transpose());
+    const int shading = mat.shading == MeshShading::BlinnPhong      ? 0
+                        : mat.shading == MeshShading::LafortuneSkin ? 1
+                                                                    : 2;
+    set_i(p, "uShading", shading);
+    set_vec3(p, "uBaseColor", shading == 1 ? mat.lafortune.rho_d : mat.base_color);
+    set_i(p, "uUseVertexColor", item.vertex_colors.empty() ? 0 : 1);
+    set_f(p, "uSpecular", mat.specular);
+    set_f(p, "uShininess", mat.shininess);
+    set_f(p, "uAmbient", mat.ambient);
+    set_vec3(p, "uRhoD", mat.lafortune.rho_d);
+    if (mat.lafortune.lobes.size() > std::size_t(kMaxLobes))
+      fail("render: at most {} Lafortune lobes are supported", kMaxLobes);
+    set_i(p, "uNumLobes", int(mat.lafortune.lobes.size()));
+    for (std::size_t l = 0; l < mat.lafortune.lobes.size(); ++l) {
+      set_vec3(p, fmt::format("uCxy[{}]", l).c_str(), mat.lafortune.lobes[l].cxy);
+      set_vec3(p, fmt::format("uCz[{}]", l).c_str(), mat.lafortune.lobes[l].cz);
+      set_vec3(p, fmt::format("uN[{}]", l).c_str(), mat.lafortune.lobes[l].n);
+    }
+    const bool albedo = mat.albedo_map && d.has_uvs;
+    const bool height = mat.height_map && d.has_uvs && shading != 2;
+    const bool nmap = mat.normal_map && d.has_uvs && shading != 2;
+    set_i(p, "uUseAlbedo", albedo ? 1 : 0);
+    set_i(p, "uUseHeight", height ? 1 : 0);
+    set_i(p, "uUseNormalMap", nmap ? 1 : 0);
+    if (albedo) {
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, texture(mat.albedo_map, GL_SRGB8_ALPHA8, GL_RGBA,
+                                           GL_UNSIGNED_BYTE, true));
+    }
+    if (height) {
+      glActiveTexture(GL_TEXTURE1);
+      glBindTexture(GL_TEXTURE_2D, texture(mat.height_map, GL_R32F, GL_RED, GL_FLOAT, false));
+      glUniform2f(glGetUniformLocation(p, "uHeightTexel"), 1.0f / mat.height_map->width(),
+                  1.0f / mat.height_map->height());
+      set_f(p, "uBumpStrength", mat.bump_strength);
+    }
+    if (nmap) {
+      glActiveTexture(GL_TEXTURE2);
+      glBindTexture(GL_TEXTURE_2D, texture(mat.normal_map, GL_RGB16F, GL_RGB, GL_FLOAT, true));
+    }
+    glBindVertexArray(d.vao);
+    glDrawArrays(GL_TRIANGLES, 0, d.count);
+  }
+
+  StrandDraw upload_strands(FrameObjects& fo, const StrandItem& item, std::size_t index,
+                            Eigen::AlignedBox3d* shadow_box) {
+    const geom::StrandSet& s = *item.strands;
+    const std::string where = fmt::format("render: strands[{}]", index);
+    const std::size_t np = s.points.size();
+    if (s.offsets.empty() || s.offsets.front() != 0 || s.offsets.back() != np)
+      fail_at(where, "offsets do not cover the {} points", np);
+    if (!s.color.empty() && s.color.size() != np)
+      fail_at(where, "{} colours for {} points", s.color.size(), np);
+    if (!s.radius.empty() && s.radius.size() != np)
+      fail_at(where, "{} radii for {} points", s.radius.size(), np);
+    StrandDraw d;
+    d.item = &item;
+    d.ribbons = !s.radius.empty() || item.material.width_px > m_line_width_range[1] / 2;
+    std::vector<StrandVertex> v(np);
+    const Vec3f mc = item.material.color.cast<float>();
+    for (std::size_t st = 0; st < s.num_strands(); ++st) {
+      const uint32_t b = s.offsets[st], e = s.offsets[st + 1];
+      if (e < b) fail_at(where, "offsets decrease at strand {}", st);
+      if (e - b >= 2) {
+        d.first.push_back(GLint(b));
+        d.count.push_back(GLsizei(e - b));
+      }
+      for (uint32_t i = b; i < e; ++i) {
+        const Vec3f& p = s.points[i];
+        if (!p.allFinite()) fail_at(where, "point {} is not finite", i);
+        if (shadow_box) extend(*shadow_box, item.transform, p.cast<double>());
+        const Vec3f t = (s.points[std::min(i + 1, e - 1)] - s.points[i > b ? i - 1 : b]);
+        const Vec3f tn = t.norm() > 0 ? Vec3f(t.normalized()) : Vec3f(0, 1, 0);
+        const Vec3f c = s.color.empty() ? mc : s.color[i];
+        StrandVertex& sv = v[i];
+        for (int j = 0; j < 3; ++j) {
+          sv.pos[j] = p[j];
+          sv.color[j] = c[j];
+          sv.tangent[j] = tn[j];
+        }
+        sv.radius = s.radius.empty() ? -1.0f : s.radius[i];
+      }
+    }
+    d.vao = fo.vao();
+    fo.buffer(GL_ARRAY_BUFFER, v.size() * sizeof(StrandVertex), v.data());
+    const std::size_t sz = sizeof(StrandVertex);
+    attrib(0, 3, sz, offsetof(StrandVertex, pos));
+    attrib(1, 3, sz, offsetof(StrandVertex, color));
+    attrib(2, 3, sz, offsetof(StrandVertex, tangent));
+    attrib(3, 1, sz, offsetof(StrandVertex, radius));
+    return d;
+  }
+
+  void draw_strands(const RenderScene& scene, const RenderSettings& settings,
+                    const std::vector<StrandDraw>& strands, const Mat4& view_proj,
+                    const Mat4& proj) {
+    const int k = settings.supersample;
+    for (const StrandDraw& d : strands) {
+      const StrandMaterial& mat = d.item->material;
+      const GLuint p = d.ribbons ? m_ribbon_prog : m_line_prog;
+      glUseProgram(p);
+      set_mat4(p, "uViewProj", view_proj);
+      set_lights(p, scene);
+      set_mat4(p, "uModel", d.item->transform.matrix());
+      set_f(p, "uModelScale", linear_scale(d.item->transform));
+      set_f(p, "uPixelScale", proj(1, 1) * 0.5 * m_fb_h);
+      set_f(p, "uWidthPx", mat.width_px * k);
+      if (d.ribbons)
+        glUniform2f(glGetUniformLocation(p, "uViewport"), float(m_fb_w), float(m_fb_h));
+      set_i(p, "uShading", mat.shading == StrandShading::KajiyaKay ? 1 : 0);
+      set_f(p, "uDiffuse", mat.diffuse);
+      set_f(p, "uSpecular", mat.specular);
+      set_f(p, "uShininess", mat.shininess);
+      set_f(p, "uAmbient", mat.ambient);
+      double opacity = mat.opacity;
+      if (!d.ribbons) {
+        // GL lines narrower than one framebuffer pixel: keep 1 px, scale the opacity.
+        const double w = mat.width_px * k;
+        glLineWidth(float(std::clamp(w, 1.0, double(m_line_width_range[1]))));
+        if (w < 1.0) opacity *= w;
+      }
+      set_f(p, "uOpacity", opacity);
+      const bool blend = opacity < 1.0 || d.ribbons;
+      if (blend) {
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+      }
+      glBindVertexArray(d.vao);
+      glMultiDrawArrays(GL_LINE_STRIP, d.first.data(), d.count.data(), GLsizei(d.first.size()));
+      glDisable(GL_BLEND);
+    }
+    glLineWidth(1.0f);
+    check_gl("strand pass");
+  }
+
+  ParticleDraw upload_particles(FrameObjects& fo, const ParticleItem& item, std::size_t index,
+                                const Mat4& view) {
+    const geom::ParticleSet& s = *item.particles;
+    const std::string where = fmt::format("render: particles[{}]", index);
+    const std::size_t n = s.positions.size();
+    auto check_size = [&](std::size_t got, const char* what) {
+      if (got != 0 && got != n) fail_at(where, "{} {} for {} particles", got, what, n);
+    };
+    check_size(s.directions.size(), "directions");
+    check_size(s.radius.size(), "radii");
+    check_size(s.color.size(), "colours");
+    check_size(s.opacity.size(), "opacities");
+    ParticleDraw d;
+    d.item = &item;
+    std::vector<ParticleInstance> inst(n);
+    std::vector<double> depth(n);
+    const Mat4 mv = view * item.transform.matrix();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3f& p = s.positions[i];
+      if (!p.allFinite()) fail_at(where, "particle {} is not finite", i);
+      ParticleInstance& q = inst[i];
+      const Vec3f c = s.color.empty() ? Vec3f(item.color.cast<float>()) : s.color[i];
+      const Vec3f t = s.directions.empty() ? Vec3f(0, 1, 0) : s.directions[i];
+      for (int j = 0; j < 3; ++j) {
+        q.pos[j] = p[j];
+        q.color[j] = c[j];
+        q.dir[j] = t[j];
+      }
+      q.radius = s.radius.empty() ? float(item.radius) : s.radius[i];
+      q.opacity = float(item.opacity) * (s.opacity.empty() ? 1.0f : s.opacity[i]);
+      if (q.opacity < 1.0f) d.blend = true;
+      depth[i] = (mv * p.cast<double>().homogeneous()).z();  // view z: more negative = farther
+    }
+    if (d.blend || item.shading == ParticleShading::HairSplat) {
+      // Back to front; stable sort keeps equal depths in input order (deterministic).
+      std::vector<std::size_t> order(n);
+      std::iota(order.begin(), order.end(), std::size_t(0));
+      std::stable_sort(order.begin(), order.end(),
+                       [&](std::size_t a, std::size_t b) { return depth[a] < depth[b]; });
+      std::vector<ParticleInstance> sorted(n);
+      for (std::size_t i = 0; i < n; ++i) sorted[i] = inst[order[i]];
+      inst.swap(sorted);
+    }
+    d.vao = fo.vao();
+    glBindBuffer(GL_ARRAY_BUFFER, m_quad_vbo);
+    attrib(0, 2, 2 * sizeof(float), 0);
+    fo.buffer(GL_ARRAY_BUFFER, inst.size() * sizeof(ParticleInstance), inst.data());
+    const std::size_t sz = sizeof(ParticleInstance);
+    attrib(1, 3, sz, offsetof(ParticleInstance, pos), 1);
+    attrib(2, 3, sz, offsetof(ParticleInstance, color), 1);
+    attrib(3, 1, sz, offsetof(ParticleInstance, radius), 1);
+    attrib(4, 1, sz, offsetof(ParticleInstance, opacity), 1);
+    attrib(5, 3, sz, offsetof(ParticleInstance, dir), 1);
+    d.count = GLsizei(n);
+    return d;
+  }
+
+  struct TexEntry {
+    std::weak_ptr<const void> owner;
+    GLuint tex = 0;
+  };
+
+  std::shared_ptr<spdlog::logger> m_log;
+  std::unique_ptr<EglContext> m_egl;
+  std::string m_description;
+  GLuint m_mesh_prog = 0, m_line_prog = 0, m_ribbon_prog = 0, m_depth_prog = 0,
+         m_particle_prog = 0, m_resolve_prog = 0;
+  GLuint m_empty_vao = 0, m_quad_vbo = 0;
+  GLuint m_fbo = 0, m_color_tex = 0, m_depth_rb = 0, m_out_fbo = 0, m_out_rb = 0;
+  GLuint m_shadow_fbo = 0, m_shadow_tex = 0;
+  int m_fb_w = 0, m_fb_h = 0, m_out_w = 0, m_out_h = 0, m_shadow_size = 0;
+  float m_line_width_range[2] = {1, 1};
+  std::map<const void*, TexEntry> m_tex_cache;
+};
+
+}  // namespace
+
+std::unique_ptr<Renderer> Renderer::create_headless(const Context& ctx) {
+  auto egl = EglContext::create();
+  return std::make_unique<GlRenderer>(ctx, std::move(egl));
+}
+
+std::unique_ptr<Renderer> Renderer::create_with_current_context(const Context& ctx) {
+  return std::make_unique<GlRenderer>(ctx, nullptr);
+}
+
+}  // namespace follicle::render

@@ -1,0 +1,85 @@
+#include "follicle/scene/scene.hpp"
+
+#include <fmt/format.h>
+
+#include <set>
+
+namespace follicle::scene {
+
+Affine3 Transform::matrix() const {
+  const double k = kPi / 180.0;
+  const Mat3 r = (Eigen::AngleAxisd(rotate_deg.z() * k, Vec3::UnitZ()) *
+                  Eigen::AngleAxisd(rotate_deg.y() * k, Vec3::UnitY()) *
+                  Eigen::AngleAxisd(rotate_deg.x() * k, Vec3::UnitX()))
+                     .toRotationMatrix();
+  Affine3 m = Affine3::Identity();
+  m.linear() = r * scale;
+  m.translation() = translate;
+  return m;
+}
+
+void Scene::validate(const JsonSource& src) const {
+  // Per-key types and ranges were checked while reading; these span several keys.
+  const Vec3 view = camera.target - camera.eye;
+  if (view.norm() < 1e-9)
+    json_fail(src, "camera.target", "camera target coincides with camera eye");
+  if (camera.up.norm() < 1e-12) json_fail(src, "camera.up", "up vector is zero");
+  if (view.normalized().cross(camera.up.normalized()).norm() < 1e-6)
+    json_fail(src, "camera.up", "up vector is parallel to the viewing direction");
+  if (!(camera.near < camera.far))
+    json_fail(src, "camera.far",
+              fmt::format("far ({}) must be greater than near ({})", camera.far, camera.near));
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < assets.meshes.size(); ++i) {
+    const auto& m = assets.meshes[i];
+    const std::string p = index_path("assets.meshes", i);
+    if (m.path.empty()) json_fail(src, p + ".path", "mesh path is empty");
+    if (!m.name.empty() && !names.insert(m.name).second)
+      json_fail(src, p + ".name", "duplicate mesh name \"" + m.name + "\"");
+  }
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    if (lights[i].direction.norm() < 1e-12)
+      json_fail(src, index_path("lights", i) + ".direction", "light direction is zero");
+  }
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const auto& o = outputs[i];
+    const std::string p = index_path("outputs", i) + ".path";
+    if (o.path.empty()) json_fail(src, p, "output path is empty");
+    if (o.type == OutputType::Image) {
+      auto ext = std::filesystem::path(o.path).extension().string();
+      for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+      if (ext != ".png")
+        json_fail(src, p, "an image output must end in .png, got \"" + o.path + "\"");
+    }
+  }
+}
+
+Scene read_scene(const Json& j, const JsonSource& src) {
+  if (!j.is_object())
+    json_fail(src, "", "expected a JSON object with \"follicle_scene\": 1, got " + describe_json(j));
+  auto v = j.find("follicle_scene");
+  if (v == j.end())
+    json_fail(src, "follicle_scene",
+              fmt::format("missing required key \"follicle_scene\" (the scene format version; "
+                          "this Follicle reads {}): is this a Follicle scene file?",
+                          kSceneVersion));
+  if (!v->is_number_integer())
+    json_fail(src, "follicle_scene",
+              "expected the integer scene format version, got " + describe_json(*v));
+  if (v->get<long long>() != kSceneVersion)
+    json_fail(src, "follicle_scene",
+              fmt::format("unsupported scene format version {}: this Follicle reads version {}",
+                          v->dump(), kSceneVersion));
+  Scene s;
+  read_json(j, "", s, src);
+  s.validate(src);
+  return s;
+}
+
+Scene load_scene_file(const std::filesystem::path& path) {
+  return read_scene(parse_json_file(path), JsonSource{path.string()});
+}
+
+Json write_scene(const Scene& s) { return to_json(s); }
+
+}  // namespace follicle::scene

@@ -1,0 +1,212 @@
+#pragma once
+// The scene file (`"follicle_scene": 1`) as plain structs. Every struct lists its keys once in
+// visit(); the strict JSON reader, the writer, validation and docs/scene-format.md all come from
+// those lists (json_params.hpp). Units in the file: metres and degrees where a key says so
+// (`rotate_deg`, `fov_deg`); mesh files declare their own length unit.
+//
+// Adding a section later (hair groups, skin, animation): add a struct with visit()/validate()
+// and one line `v("hair", hair, ParamInfo{...})` in Scene::visit(); the reader, writer and docs
+// pick it up, and tests/unit/scene/scene_docs_test.cpp fails until docs/scene-format.md has the
+// generated table (`follicle docs scene-format --write docs/scene-format.md`).
+#include <array>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "follicle/core/params.hpp"
+#include "follicle/core/types.hpp"
+#include "follicle/core/units.hpp"
+#include "follicle/scene/json_params.hpp"
+
+namespace follicle::scene {
+
+/// The scene format version this build reads and writes.
+inline constexpr int kSceneVersion = 1;
+
+enum class Shading { BlinnPhong, Unlit };
+constexpr std::array<std::pair<Shading, const char*>, 2> follicle_enum_names(Shading) {
+  return {{{Shading::BlinnPhong, "blinn_phong"}, {Shading::Unlit, "unlit"}}};
+}
+
+enum class OutputType { Image };
+constexpr std::array<std::pair<OutputType, const char*>, 1> follicle_enum_names(OutputType) {
+  return {{{OutputType::Image, "image"}}};
+}
+
+/// x' = translate + R (scale x), R = Rz * Ry * Rx (rotate about fixed x, then y, then z).
+struct Transform {
+  Vec3 translate{0, 0, 0};   // [m]
+  Vec3 rotate_deg{0, 0, 0};  // [deg]
+  double scale = 1.0;
+
+  template <class V>
+  void visit(V&& v) {
+    v("translate", translate, ParamInfo{"translation, applied last", "m"});
+    v("rotate_deg", rotate_deg,
+      ParamInfo{"rotation about the fixed x, then y, then z axis", "deg", -360.0, 360.0});
+    v("scale", scale, ParamInfo{"uniform scale factor, applied first", "", 1e-6, 1e6});
+  }
+  Affine3 matrix() const;
+};
+
+struct Material {
+  Shading shading = Shading::BlinnPhong;
+  Vec3 base_color{0.8, 0.65, 0.55};
+  std::string texture;  // relative to the scene file; "" = none
+  double specular = 0.15;
+  double shininess = 32.0;
+  double ambient = 0.15;
+
+  template <class V>
+  void visit(V&& v) {
+    v("shading", shading, ParamInfo{"shading model"});
+    v("base_color", base_color,
+      ParamInfo{"linear RGB colour used where there is no texture", "", 0.0, 1.0});
+    v("texture", texture,
+      ParamInfo{"albedo texture (PNG/JPEG, sRGB) over the mesh UVs, relative to the scene file"});
+    v("specular", specular, ParamInfo{"Blinn-Phong specular weight", "", 0.0, 1.0});
+    v("shininess", shininess, ParamInfo{"Blinn-Phong exponent", "", 1.0, 10000.0});
+    v("ambient", ambient, ParamInfo{"ambient weight", "", 0.0, 1.0});
+  }
+};
+
+struct MeshAsset {
+  static constexpr const char* kRequired[] = {"path", "units"};
+  std::string name;   // optional id other sections refer to (e.g. hair grows on "head")
+  std::string path;   // relative to the scene file
+  LengthUnit units = LengthUnit::m;
+  Transform transform;
+  Material material;
+  bool cast_shadow = true;
+  bool visible = true;
+
+  template <class V>
+  void visit(V&& v) {
+    v("name", name, ParamInfo{"identifier other sections use to refer to this mesh"});
+    v("path", path, ParamInfo{"mesh file (.obj, .ply, .gltf, .glb), relative to the scene file"});
+    v("units", units, ParamInfo{"length unit of the coordinates in the file"});
+    v("transform", transform, ParamInfo{"placement in the scene"});
+    v("material", material, ParamInfo{"surface appearance"});
+    v("cast_shadow", cast_shadow, ParamInfo{"whether the mesh casts shadows"});
+    v("visible", visible, ParamInfo{"whether the mesh is drawn"});
+  }
+};
+
+struct Assets {
+  std::vector<MeshAsset> meshes;
+
+  template <class V>
+  void visit(V&& v) {
+    v("meshes", meshes, ParamInfo{"triangle meshes"});
+  }
+};
+
+struct CameraSpec {
+  Vec3 eye{0, 0, 1};
+  Vec3 target{0, 0, 0};
+  Vec3 up{0, 1, 0};
+  double fov_deg = 30.0;
+  double near = 0.01;
+  double far = 100.0;
+
+  template <class V>
+  void visit(V&& v) {
+    v("eye", eye, ParamInfo{"camera position", "m"});
+    v("target", target, ParamInfo{"point the camera looks at", "m"});
+    v("up", up, ParamInfo{"up direction (need not be unit or orthogonal to the view)"});
+    v("fov_deg", fov_deg, ParamInfo{"vertical field of view", "deg", 1.0, 179.0});
+    v("near", near, ParamInfo{"near clipping distance", "m", 1e-6, 1e6});
+    v("far", far, ParamInfo{"far clipping distance", "m", 1e-6, 1e9});
+  }
+};
+
+struct LightSpec {
+  std::string name;
+  Vec3 direction{-0.3, -0.5, -1.0};
+  Vec3 color{1, 1, 1};
+  double intensity = 1.0;
+  bool shadow = false;
+
+  template <class V>
+  void visit(V&& v) {
+    v("name", name, ParamInfo{"label (e.g. \"key\", \"fill\", \"rim\")"});
+    v("direction", direction,
+      ParamInfo{"direction the light travels, from the light into the scene (any length)"});
+    v("color", color, ParamInfo{"linear RGB colour", "", 0.0, 1.0});
+    v("intensity", intensity, ParamInfo{"multiplier on colour", "", 0.0, 100.0});
+    v("shadow", shadow, ParamInfo{"casts a shadow map"});
+  }
+};
+
+struct RenderSpec {
+  int width = 800;
+  int height = 800;
+  int supersample = 2;
+  Vec3 background{0.12, 0.12, 0.14};
+  Vec3 ambient_color{1, 1, 1};
+  int shadow_map_size = 2048;
+
+  template <class V>
+  void visit(V&& v) {
+    v("width", width, ParamInfo{"image width", "px", 1, 16384});
+    v("height", height, ParamInfo{"image height", "px", 1, 16384});
+    v("supersample", supersample,
+      ParamInfo{"render at this multiple of the size and box-filter down", "", 1, 8});
+    v("background", background, ParamInfo{"linear RGB background colour", "", 0.0, 1.0});
+    v("ambient_color", ambient_color,
+      ParamInfo{"linear RGB ambient light (scaled by each material's ambient)", "", 0.0, 10.0});
+    v("shadow_map_size", shadow_map_size, ParamInfo{"shadow map resolution", "px", 256, 16384});
+  }
+};
+
+struct OutputSpec {
+  static constexpr const char* kRequired[] = {"type", "path"};
+  OutputType type = OutputType::Image;
+  std::string path;  // relative to the current working directory
+
+  template <class V>
+  void visit(V&& v) {
+    v("type", type, ParamInfo{"what to write"});
+    v("path", path,
+      ParamInfo{"output file (.png), relative to the working directory; `follicle render -o` "
+                "overrides it"});
+  }
+};
+
+struct Scene {
+  static constexpr const char* kRequired[] = {"follicle_scene"};
+  int follicle_scene = kSceneVersion;
+  std::string description;
+  Assets assets;
+  CameraSpec camera;
+  std::vector<LightSpec> lights;
+  RenderSpec render;
+  std::vector<OutputSpec> outputs;
+
+  template <class V>
+  void visit(V&& v) {
+    v("follicle_scene", follicle_scene,
+      ParamInfo{"scene format version", "", double(kSceneVersion), double(kSceneVersion)});
+    v("description", description, ParamInfo{"free text"});
+    v("assets", assets, ParamInfo{"files the scene uses"});
+    v("camera", camera, ParamInfo{"perspective camera"});
+    v("lights", lights, ParamInfo{"directional lights"});
+    v("render", render, ParamInfo{"image settings"});
+    v("outputs", outputs, ParamInfo{"files `follicle render` writes when no -o is given"});
+  }
+
+  /// Cross-field checks the per-key ranges cannot express (near < far, eye != target, unique
+  /// mesh names, ...). Errors name the file and the JSON path.
+  void validate(const JsonSource& src) const;
+};
+
+/// Reads a scene from parsed JSON: checks the version first (clear message for a missing or
+/// newer version), then every key strictly, then Scene::validate().
+Scene read_scene(const Json& j, const JsonSource& src);
+/// parse_json_file + read_scene.
+Scene load_scene_file(const std::filesystem::path& path);
+/// Scene -> JSON (every key, defaults included); read_scene(write_scene(s)) == s.
+Json write_scene(const Scene& s);
+
+}  // namespace follicle::scene

@@ -1,0 +1,180 @@
+#include "follicle/scene/session.hpp"
+
+#include <fmt/format.h>
+
+#include "follicle/core/log.hpp"
+#include "follicle/geom/mesh_io.hpp"
+#include "follicle/image/image_io.hpp"
+
+namespace follicle::scene {
+
+namespace {
+
+render::MeshShading to_render(Shading s) {
+  switch (s) {
+    case Shading::BlinnPhong: return render::MeshShading::BlinnPhong;
+    case Shading::Unlit: return render::MeshShading::Unlit;
+  }
+  return render::MeshShading::BlinnPhong;
+}
+
+}  // namespace
+
+Session Session::load(const std::filesystem::path& scene_file, const Context& ctx) {
+  const Json j = parse_json_file(scene_file);
+  return from_json(j, scene_file.parent_path(), scene_file.string(), ctx);
+}
+
+Session Session::from_json(const Json& j, const std::filesystem::path& base_dir,
+                           const std::string& name_for_errors, const Context& ctx) {
+  return Session(read_scene(j, JsonSource{name_for_errors}), base_dir, name_for_errors, ctx);
+}
+
+Session::Session(Scene scene, std::filesystem::path base_dir, std::string source_name,
+                 const Context& ctx)
+    : m_scene(std::move(scene)), m_base_dir(std::move(base_dir)), m_source(std::move(source_name)),
+      m_ctx(&ctx) {
+  validate();
+}
+
+void Session::validate() const {
+  const JsonSource src{m_source};
+  validate_params(m_scene, "");  // per-key ranges again, in case scene() was edited
+  m_scene.validate(src);
+  // Referenced files must exist; the message names the JSON path and the resolved file.
+  for (std::size_t i = 0; i < m_scene.assets.meshes.size(); ++i) {
+    const auto& m = m_scene.assets.meshes[i];
+    const std::string p = index_path("assets.meshes", i);
+    const auto file = resolve(m.path);
+    if (!std::filesystem::is_regular_file(file))
+      json_fail(src, p + ".path", "mesh file not found: " + file.string());
+    if (!m.material.texture.empty()) {
+      const auto tex = resolve(m.material.texture);
+      if (!std::filesystem::is_regular_file(tex))
+        json_fail(src, p + ".material.texture", "texture file not found: " + tex.string());
+    }
+  }
+}
+
+std::filesystem::path Session::resolve(const std::string& relative) const {
+  const std::filesystem::path p(relative);
+  if (p.is_absolute() || m_base_dir.empty()) return p;
+  return m_base_dir / p;
+}
+
+std::shared_ptr<const geom::TriMesh> Session::mesh(std::size_t index) {
+  if (index >= m_scene.assets.meshes.size())
+    fail("mesh index {} out of range ({} meshes)", index, m_scene.assets.meshes.size());
+  const auto& a = m_scene.assets.meshes[index];
+  const auto file = resolve(a.path);
+  const std::string key = file.lexically_normal().string() + "|" + to_string(a.units);
+  if (auto it = m_meshes.find(key); it != m_meshes.end()) return it->second;
+  m_ctx->log().info("loading mesh {} ({})", file.string(), to_string(a.units));
+  auto mesh = std::make_shared<geom::TriMesh>(geom::load_mesh(file, a.units));
+  if (!mesh->has_normals()) mesh->compute_normals();
+  m_meshes.emplace(key, mesh);
+  return mesh;
+}
+
+std::size_t Session::mesh_index(const std::string& name) const {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < m_scene.assets.meshes.size(); ++i) {
+    if (m_scene.assets.meshes[i].name == name) return i;
+    names.push_back(m_scene.assets.meshes[i].name);
+  }
+  const std::string hint = did_you_mean(name, names);
+  fail_at(m_source, "no mesh asset named \"{}\"{}", name,
+          hint.empty() ? "" : fmt::format(" (did you mean \"{}\"?)", hint));
+}
+
+std::shared_ptr<const image::ImageRGBA8> Session::texture(const std::string& relative) {
+  const auto file = resolve(relative);
+  const std::string key = file.lexically_normal().string();
+  if (auto it = m_textures.find(key); it != m_textures.end()) return it->second;
+  m_ctx->log().info("loading texture {}", file.string());
+  auto img = std::make_shared<image::ImageRGBA8>(image::read_png_rgba(file));
+  m_textures.emplace(key, img);
+  return img;
+}
+
+void Session::load_all_assets() {
+  for (std::size_t i = 0; i < m_scene.assets.meshes.size(); ++i) {
+    mesh(i);
+    if (!m_scene.assets.meshes[i].material.texture.empty())
+      texture(m_scene.assets.meshes[i].material.texture);
+  }
+}
+
+render::RenderScene Session::render_scene(int frame) {
+  if (frame < 0) fail("frame {} is negative", frame);
+  render::RenderScene rs;
+  const auto& c = m_scene.camera;
+  rs.camera.eye = c.eye;
+  rs.camera.target = c.target;
+  rs.camera.up = c.up;
+  rs.camera.fov_y = c.fov_deg * kPi / 180.0;
+  rs.camera.z_near = c.near;
+  rs.camera.z_far = c.far;
+  for (const auto& l : m_scene.lights) {
+    render::DirectionalLight dl;
+    dl.direction = l.direction.normalized();
+    dl.color = l.color;
+    dl.intensity = l.intensity;
+    dl.cast_shadow = l.shadow;
+    rs.lights.push_back(dl);
+  }
+  rs.ambient_color = m_scene.render.ambient_color;
+  rs.background = m_scene.render.background;
+  for (std::size_t i = 0; i < m_scene.assets.meshes.size(); ++i) {
+    const auto& a = m_scene.assets.meshes[i];
+    if (!a.visible) continue;
+    render::MeshItem item;
+    item.mesh = mesh(i);
+    item.transform = a.transform.matrix();
+    item.cast_shadow = a.cast_shadow;
+    auto& mat = item.material;
+    mat.shading = to_render(a.material.shading);
+    mat.base_color = a.material.base_color;
+    mat.specular = a.material.specular;
+    mat.shininess = a.material.shininess;
+    mat.ambient = a.material.ambient;
+    if (!a.material.texture.empty()) mat.albedo_map = texture(a.material.texture);
+    rs.meshes.push_back(std::move(item));
+  }
+  return rs;
+}
+
+render::RenderSettings Session::render_settings() const {
+  render::RenderSettings s;
+  s.width = m_scene.render.width;
+  s.height = m_scene.render.height;
+  s.supersample = m_scene.render.supersample;
+  s.shadow_map_size = m_scene.render.shadow_map_size;
+  return s;
+}
+
+std::string Session::summary() const {
+  std::string out;
+  out += fmt::format("scene: {} (format version {})\n", m_source, m_scene.follicle_scene);
+  if (!m_scene.description.empty()) out += fmt::format("description: {}\n", m_scene.description);
+  out += fmt::format("meshes: {}\n", m_scene.assets.meshes.size());
+  for (const auto& m : m_scene.assets.meshes) {
+    out += fmt::format("  {} {} [{}]{}{}\n", m.name.empty() ? "-" : m.name, m.path,
+                       to_string(m.units),
+                       m.material.texture.empty() ? "" : ", texture " + m.material.texture,
+                       m.visible ? "" : ", hidden");
+  }
+  const auto& c = m_scene.camera;
+  out += fmt::format("camera: eye ({:.3f}, {:.3f}, {:.3f}) m, target ({:.3f}, {:.3f}, {:.3f}) m, "
+                     "fov {} deg\n",
+                     c.eye.x(), c.eye.y(), c.eye.z(), c.target.x(), c.target.y(), c.target.z(),
+                     c.fov_deg);
+  out += fmt::format("lights: {}\n", m_scene.lights.size());
+  out += fmt::format("render: {}x{} px, supersample {}\n", m_scene.render.width,
+                     m_scene.render.height, m_scene.render.supersample);
+  out += fmt::format("outputs: {}\n", m_scene.outputs.size());
+  for (const auto& o : m_scene.outputs) out += fmt::format("  image {}\n", o.path);
+  return out;
+}
+
+}  // namespace follicle::scene

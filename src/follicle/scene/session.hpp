@@ -1,0 +1,69 @@
+#pragma once
+// Session: a loaded, validated scene plus everything derived from it (loaded meshes and
+// textures, later simulation state). It turns the scene into a render::RenderScene per frame; the
+// renderer never sees the scene file or a solver.
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "follicle/core/context.hpp"
+#include "follicle/geom/trimesh.hpp"
+#include "follicle/image/image.hpp"
+#include "follicle/render/render_scene.hpp"
+#include "follicle/scene/scene.hpp"
+
+namespace follicle::scene {
+
+class Session {
+ public:
+  /// Parses and validates `scene_file` (strict: unknown keys, wrong types, out-of-range values
+  /// and missing asset files are errors naming the file and JSON path). Meshes load lazily.
+  /// `ctx` must outlive the Session.
+  static Session load(const std::filesystem::path& scene_file, const Context& ctx);
+  /// From parsed JSON; relative asset paths resolve against `base_dir`.
+  static Session from_json(const Json& j, const std::filesystem::path& base_dir,
+                           const std::string& name_for_errors, const Context& ctx);
+  /// From an already built Scene (validated here).
+  Session(Scene scene, std::filesystem::path base_dir, std::string source_name,
+          const Context& ctx);
+
+  const Scene& scene() const { return m_scene; }
+  /// For command-line overrides (e.g. --width); call validate() after editing.
+  Scene& scene() { return m_scene; }
+  void validate() const;
+  const std::filesystem::path& base_dir() const { return m_base_dir; }
+  /// The file the scene came from (for messages).
+  const std::string& source_name() const { return m_source; }
+  const Context& context() const { return *m_ctx; }
+
+  /// A path from the scene file resolved against the scene's folder.
+  std::filesystem::path resolve(const std::string& relative) const;
+
+  /// The mesh of assets.meshes[index] in metres (file units converted; the asset transform is
+  /// NOT applied, it goes into MeshItem::transform), with vertex normals. Cached.
+  std::shared_ptr<const geom::TriMesh> mesh(std::size_t index);
+  /// Index of the mesh asset called `name`; throws when there is none.
+  std::size_t mesh_index(const std::string& name) const;
+  /// A texture (PNG/JPEG) by scene-relative path. Cached.
+  std::shared_ptr<const image::ImageRGBA8> texture(const std::string& relative);
+  /// Loads every asset now (for `follicle validate`): malformed files fail here.
+  void load_all_assets();
+
+  /// What to draw at `frame` (frame >= 0; static scenes look the same at every frame).
+  render::RenderScene render_scene(int frame = 0);
+  render::RenderSettings render_settings() const;
+
+  /// A few lines describing the scene (for `follicle info`).
+  std::string summary() const;
+
+ private:
+  Scene m_scene;
+  std::filesystem::path m_base_dir;
+  std::string m_source;
+  const Context* m_ctx;
+  std::map<std::string, std::shared_ptr<const geom::TriMesh>> m_meshes;
+  std::map<std::string, std::shared_ptr<const image::ImageRGBA8>> m_textures;
+};
+
+}  // namespace follicle::scene

@@ -1,0 +1,128 @@
+#include "follicle/sim/voxel_planes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "follicle/core/error.hpp"
+#include "follicle/core/rng.hpp"
+
+namespace follicle::sim {
+
+uint64_t VoxelPlanes::key(const Eigen::Vector3i& c) {
+  // 21 bits per axis, offset so negative cells stay distinct.
+  auto f = [](int v) { return uint64_t(uint32_t(v + (1 << 20)) & 0x1FFFFFu); };
+  return f(c.x()) | (f(c.y()) << 21) | (f(c.z()) << 42);
+}
+
+Eigen::Vector3i VoxelPlanes::cell(const Vec3& x) const {
+  return Eigen::Vector3i(int(std::floor(x.x() / m_size)), int(std::floor(x.y() / m_size)),
+                         int(std::floor(x.z() / m_size)));
+}
+
+VoxelPlanes VoxelPlanes::build(const std::vector<const geom::TriMesh*>& meshes,
+                               const VoxelPlanesParams& params, uint64_t seed) {
+  params.validate();
+  if (meshes.empty()) fail("voxel planes: no body mesh given");
+  VoxelPlanes vp;
+  vp.m_size = params.voxel_size;
+  const double density = params.samples_per_voxel / (params.voxel_size * params.voxel_size);
+  struct Acc {
+    Vec3 p = Vec3::Zero();
+    Vec3 n = Vec3::Zero();
+    int count = 0;
+  };
+  std::unordered_map<uint64_t, Acc> acc;
+  Rng rng = Rng::stream(seed, 0x564f58ull);
+  for (std::size_t mi = 0; mi < meshes.size(); ++mi) {
+    const geom::TriMesh* m = meshes[mi];
+    if (!m || m->faces.empty()) fail("voxel planes: body mesh {} is empty", mi);
+    const auto nv = m->positions.size();
+    for (std::size_t f = 0; f < m->faces.size(); ++f) {
+      const Vec3i& fc = m->faces[f];
+      for (int k = 0; k < 3; ++k)
+        if (fc[k] < 0 || std::size_t(fc[k]) >= nv)
+          fail("voxel planes: body mesh {} face {} has vertex index {} out of range [0, {})", mi, f,
+               fc[k], nv);
+      const Vec3 &a = m->positions[fc[0]], &b = m->positions[fc[1]], &c = m->positions[fc[2]];
+      if (!a.allFinite() || !b.allFinite() || !c.allFinite())
+        fail("voxel planes: body mesh {} face {} has a non-finite vertex", mi, f);
+      const Vec3 cr = (b - a).cross(c - a);
+      const double area = 0.5 * cr.norm();
+      if (area <= 0) continue;
+      const Vec3 n = cr.normalized();
+      // Number of samples proportional to area; the fractional part is drawn at random.
+      const double expect = area * density;
+      int count = int(std::floor(expect));
+      if (rng.uniform() < expect - count) ++count;
+      for (int s = 0; s < count; ++s) {
+        double r1 = rng.uniform(), r2 = rng.uniform();
+        if (r1 + r2 > 1) {
+          r1 = 1 - r1;
+          r2 = 1 - r2;
+        }
+        const Vec3 p = a + r1 * (b - a) + r2 * (c - a);
+        Acc& e = acc[key(vp.cell(p))];
+        e.p += p;
+        e.n += n;
+        ++e.count;
+        ++vp.m_num_samples;
+      }
+    }
+  }
+  for (auto& [k, e] : acc) {
+    BodyPlane pl;
+    pl.p = e.p / e.count;
+    const double nn = e.n.norm();
+    if (nn < 1e-9) continue;  // opposite sheets cancel: no usable plane
+    pl.n = e.n / nn;
+    vp.m_planes.emplace(k, pl);
+  }
+  return vp;
+}
+
+const BodyPlane* VoxelPlanes::find(const Vec3& x) const {
+  if (m_planes.empty()) return nullptr;
+  auto it = m_planes.find(key(cell(x)));
+  return it == m_planes.end() ? nullptr : &it->second;
+}
+
+double VoxelPlanes::distance(const Vec3& x) const {
+  const BodyPlane* pl = find(x);
+  if (!pl) return std::numeric_limits<double>::infinity();
+  return (x - pl->p).dot(pl->n);  // (3.19)
+}
+
+std::vector<BodyPlane> VoxelPlanes::planes() const {
+  std::vector<BodyPlane> out;
+  out.reserve(m_planes.size());
+  for (const auto& [k, p] : m_planes) out.push_back(p);
+  return out;
+}
+
+Vec3 body_contact_accel(const BodyPlane& plane, const Vec3& x, const Vec3& v_rel, const Vec3& a,
+                        double dt, const BodyContactParams& params) {
+  const Vec3& n = plane.n;
+  const double d = (x - plane.p).dot(n);  // (3.19) distance from the body surface
+  if (!(d < params.threshold)) return Vec3::Zero();
+  Vec3 out = Vec3::Zero();
+  const Vec3 vn = v_rel.dot(n) * n, vt = v_rel - vn;
+  const Vec3 an = a.dot(n) * n, at = a - an;
+  const Vec3 vn1 = vn + an * dt;  // (3.20) normal velocity after the step
+  if (vn1.dot(n) <= 0) {
+    const Vec3 fc = -an - vn / dt;  // (3.21) stop the particle at the surface (inelastic)
+    out += fc;
+    const Vec3 vt1 = vt + at * dt;  // (3.22) tangential velocity without friction
+    const double vt1n = vt1.norm();
+    const double fcn = fc.norm();
+    if (vt1n < params.mu * fcn * dt) {
+      out += -vt1 / dt;  // (3.23) sticking
+    } else if (vt1n > 0) {
+      out += -params.mu * fcn * vt1 / vt1n;  // (3.23) sliding
+    }
+  }
+  if (d < 0) out += -params.k_r * d * n;  // (3.24) repulsion (per unit mass)
+  return out;
+}
+
+}  // namespace follicle::sim

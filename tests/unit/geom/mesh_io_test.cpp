@@ -1,0 +1,309 @@
+// Mesh I/O: round trips in every format, units, the shipped head, malformed inputs.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+
+#include "follicle/core/atomic_file.hpp"
+#include "follicle/core/error.hpp"
+#include "follicle/core/rng.hpp"
+#include "follicle/geom/mesh_io.hpp"
+#include "testing/testing.hpp"
+
+using namespace follicle;
+using namespace follicle::geom;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A unit cube with separately indexed UVs (seams: 14 UVs for 8 vertices).
+TriMesh make_cube() {
+  TriMesh m;
+  m.name = "cube";
+  for (int i = 0; i < 8; ++i) m.positions.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (int q = 0; q < 6; ++q) {
+    m.faces.emplace_back(quads[q][0], quads[q][1], quads[q][2]);
+    m.faces.emplace_back(quads[q][0], quads[q][2], quads[q][3]);
+  }
+  for (int i = 0; i < 14; ++i) m.uvs.emplace_back(0.05 * i, 1.0 - 0.03 * i);
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    m.uv_faces.emplace_back(int(f % 14), int((f + 3) % 14), int((f + 7) % 14));
+  m.compute_normals();
+  return m;
+}
+
+void write_text(const fs::path& p, const std::string& s) {
+  std::ofstream f(p, std::ios::binary);
+  f << s;
+}
+
+// Compares surfaces corner by corner (positions and UVs), allowing vertex splits at seams.
+void expect_same_surface(const TriMesh& a, const TriMesh& b, double tol, bool uvs = true) {
+  ASSERT_EQ(a.num_faces(), b.num_faces());
+  for (std::size_t f = 0; f < a.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 pa = a.positions[std::size_t(a.faces[f][k])];
+      const Vec3 pb = b.positions[std::size_t(b.faces[f][k])];
+      ASSERT_LE((pa - pb).norm(), tol) << "face " << f << " corner " << k;
+      if (uvs && a.has_uvs()) {
+        ASSERT_TRUE(b.has_uvs());
+        const Vec2 ua = a.uvs[std::size_t(a.uv_faces[f][k])];
+        const Vec2 ub = b.uvs[std::size_t(b.uv_faces[f][k])];
+        ASSERT_LE((ua - ub).norm(), 1e-6) << "face " << f << " corner " << k;
+      }
+    }
+}
+
+}  // namespace
+
+TEST(MeshIO, ObjRoundTripKeepsSeparateUvIndices) {
+  const auto dir = test::scratch_dir("obj");
+  const TriMesh cube = make_cube();
+  save_mesh(cube, dir / "c.obj", LengthUnit::m);
+  const TriMesh back = load_mesh(dir / "c.obj", LengthUnit::m);
+  EXPECT_EQ(back.num_vertices(), cube.num_vertices());  // no seam splitting in OBJ
+  EXPECT_EQ(back.uvs.size(), cube.uvs.size());
+  EXPECT_EQ(back.faces, cube.faces);
+  EXPECT_EQ(back.uv_faces, cube.uv_faces);
+  expect_same_surface(cube, back, 1e-12);
+}
+
+TEST(MeshIO, UnitsConvertOnLoadAndSave) {
+  const auto dir = test::scratch_dir("units");
+  const TriMesh cube = make_cube();  // 1 m cube
+  save_mesh(cube, dir / "mm.obj", LengthUnit::mm);
+  // Text holds millimetres.
+  EXPECT_NE(read_file(dir / "mm.obj").find("v 1000 1000 1000"), std::string::npos);
+  const TriMesh as_mm = load_mesh(dir / "mm.obj", LengthUnit::mm);
+  expect_same_surface(cube, as_mm, 1e-12);
+  const TriMesh as_cm = load_mesh(dir / "mm.obj", LengthUnit::cm);  // 1000 cm = 10 m
+  EXPECT_NEAR(as_cm.bounds().sizes().x(), 10.0, 1e-12);
+}
+
+class PlyRoundTrip : public ::testing::TestWithParam<bool> {};
+
+TEST_P(PlyRoundTrip, PositionsUvsNormalsSurvive) {
+  const bool ascii = GetParam();
+  const auto dir = test::scratch_dir(ascii ? "ply-ascii" : "ply-bin");
+  const TriMesh cube = make_cube();
+  save_mesh(cube, dir / "c.ply", LengthUnit::cm, ascii);
+  const std::string head = read_file(dir / "c.ply").substr(0, 40);
+  EXPECT_NE(head.find(ascii ? "format ascii" : "format binary_little_endian"), std::string::npos);
+  const TriMesh back = load_mesh(dir / "c.ply", LengthUnit::cm);
+  expect_same_surface(cube, back, 1e-12);
+  EXPECT_EQ(back.uv_faces, back.faces);  // per-vertex UVs
+  EXPECT_GT(back.num_vertices(), cube.num_vertices());  // split at UV seams
+  ASSERT_TRUE(back.has_normals());
+}
+INSTANTIATE_TEST_SUITE_P(AsciiAndBinary, PlyRoundTrip, ::testing::Values(true, false));
+
+TEST(MeshIO, PlyBigEndianAndQuadsAndExtraElements) {
+  const auto dir = test::scratch_dir("ply-be");
+  std::string s =
+      "ply\nformat binary_big_endian 1.0\ncomment hand made\nelement vertex 4\n"
+      "property float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+      "element face 1\nproperty list uchar uint vertex_indices\n"
+      "element material 1\nproperty int id\nend_header\n";
+  auto be32 = [&](uint32_t v) {
+    for (int k = 3; k >= 0; --k) s.push_back(char((v >> (8 * k)) & 0xFF));
+  };
+  auto bef = [&](float f) {
+    uint32_t v;
+    std::memcpy(&v, &f, 4);
+    be32(v);
+  };
+  const float xy[4][2] = {{0, 0}, {2, 0}, {2, 1}, {0, 1}};
+  for (auto& p : xy) {
+    bef(p[0]);
+    bef(p[1]);
+    bef(0.5f);
+    s.push_back(char(200));
+  }
+  s.push_back(4);
+  for (uint32_t i = 0; i < 4; ++i) be32(i);
+  be32(7);
+  write_text(dir / "q.ply", s);
+  const TriMesh m = load_mesh(dir / "q.ply", LengthUnit::m);
+  ASSERT_EQ(m.num_vertices(), 4u);
+  ASSERT_EQ(m.num_faces(), 2u);  // quad fan-triangulated
+  EXPECT_EQ(m.positions[2], Vec3(2, 1, 0.5));
+  EXPECT_NEAR(m.face_area(0) + m.face_area(1), 2.0, 1e-12);
+}
+
+class GltfRoundTrip : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(GltfRoundTrip, PositionsUvsNormalsSurvive) {
+  const auto dir = test::scratch_dir("gltf");
+  const TriMesh cube = make_cube();
+  const auto path = dir / ("c" + GetParam());
+  save_mesh(cube, path, LengthUnit::m);
+  const TriMesh back = load_mesh(path, LengthUnit::m);
+  expect_same_surface(cube, back, 1e-6);  // glTF stores float32
+  EXPECT_EQ(back.uv_faces, back.faces);
+  ASSERT_TRUE(back.has_normals());
+  if (GetParam() == ".glb") {
+    EXPECT_EQ(read_file(path).substr(0, 4), "glTF");
+  }
+}
+INSTANTIATE_TEST_SUITE_P(TextAndBinary, GltfRoundTrip, ::testing::Values(".gltf", ".glb"));
+
+TEST(MeshIO, ConvertBetweenAllFormatsKeepsGeometry) {
+  const auto dir = test::scratch_dir("convert");
+  TriMesh m = make_cube();
+  const char* chain[] = {"a.obj", "b.ply", "c.glb", "d.gltf", "e.obj"};
+  for (const char* name : chain) {
+    save_mesh(m, dir / name, LengthUnit::mm);
+    m = load_mesh(dir / name, LengthUnit::mm);
+  }
+  expect_same_surface(make_cube(), m, 1e-6);
+}
+
+TEST(MeshIO, DefaultHeadLoads) {
+  const auto path = test::source_dir() / "data/meshes/lee_perry_smith/head.obj";
+  ASSERT_TRUE(fs::exists(path)) << path;
+  const TriMesh m = load_mesh(path, LengthUnit::mm);
+  EXPECT_EQ(m.num_vertices(), 8838u);
+  EXPECT_EQ(m.num_faces(), 17672u);
+  EXPECT_TRUE(m.has_uvs());
+  const Vec3 size = m.bounds().sizes();
+  // A human head in metres: between 10 cm and 50 cm along its largest axis.
+  EXPECT_GT(size.maxCoeff(), 0.10);
+  EXPECT_LT(size.maxCoeff(), 0.50);
+}
+
+TEST(MeshIO, SplitUvSeamsPreservesCorners) {
+  const TriMesh cube = make_cube();
+  const TriMesh s = split_uv_seams(cube);
+  EXPECT_EQ(s.uv_faces, s.faces);
+  EXPECT_EQ(s.uvs.size(), s.positions.size());
+  expect_same_surface(cube, s, 0.0);
+}
+
+// ---------------------------------------------------------------------------- malformed input
+
+namespace {
+void expect_error(const fs::path& p, const std::string& needle = "") {
+  try {
+    (void)load_mesh(p, LengthUnit::m);
+    ADD_FAILURE() << "no error for " << p;
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(p.filename().string()), std::string::npos) << msg;
+    if (!needle.empty()) {
+      EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+    }
+  }
+}
+}  // namespace
+
+TEST(MeshIOMalformed, ObjErrorsNameFileAndLine) {
+  const auto dir = test::scratch_dir("bad-obj");
+  write_text(dir / "nan.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
+  expect_error(dir / "nan.obj", ":3");
+  write_text(dir / "inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n");
+  expect_error(dir / "inf.obj", "not finite");
+  write_text(dir / "range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+  expect_error(dir / "range.obj", ":4");
+  write_text(dir / "neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
+  expect_error(dir / "neg.obj", ":4");
+  write_text(dir / "uvrange.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/2\n");
+  expect_error(dir / "uvrange.obj", "texture");
+  write_text(dir / "trunc.obj", "v 0 0 0\nv 1 0 0\nv 0 1");
+  expect_error(dir / "trunc.obj", ":3");
+  write_text(dir / "truncface.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2");
+  expect_error(dir / "truncface.obj", ":4");
+  write_text(dir / "empty.obj", "");
+  expect_error(dir / "empty.obj", "empty");
+  write_text(dir / "nofaces.obj", "# only a comment\nv 1 2 3\n");
+  expect_error(dir / "nofaces.obj", "no faces");
+  expect_error(dir / "missing.obj", "");
+}
+
+TEST(MeshIOMalformed, PlyErrors) {
+  const auto dir = test::scratch_dir("bad-ply");
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  write_text(dir / "nan.ply", head + "0 0 0\n1 0 0\n0 nan 0\n3 0 1 2\n");
+  expect_error(dir / "nan.ply", ":12");
+  write_text(dir / "range.ply", head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n");
+  expect_error(dir / "range.ply", ":13");
+  write_text(dir / "trunc.ply", head + "0 0 0\n1 0 0\n0 1");
+  expect_error(dir / "trunc.ply", "truncated");
+  write_text(dir / "noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n");
+  expect_error(dir / "noend.ply", "end_header");
+  write_text(dir / "empty.ply", "");
+  expect_error(dir / "empty.ply", "empty");
+  // Binary, truncated mid-vertex and with an absurd element count.
+  TriMesh tri;
+  tri.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  tri.faces = {Vec3i(0, 1, 2)};
+  save_mesh(tri, dir / "ok.ply", LengthUnit::m);
+  const std::string bin = read_file(dir / "ok.ply");
+  write_text(dir / "truncbin.ply", bin.substr(0, bin.size() - 7));
+  expect_error(dir / "truncbin.ply", "truncated");
+  std::string huge = bin;
+  huge.replace(huge.find("element vertex 3"), 16, "element vertex 300000000");
+  write_text(dir / "huge.ply", huge);
+  expect_error(dir / "huge.ply", "truncated");
+  // Binary NaN coordinate.
+  std::string nanbin = bin;
+  const std::size_t body = nanbin.find("end_header\n") + 11;
+  const double qnan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(nanbin.data() + body + 8, &qnan, 8);
+  write_text(dir / "nanbin.ply", nanbin);
+  expect_error(dir / "nanbin.ply", "not finite");
+}
+
+TEST(MeshIOMalformed, GltfErrors) {
+  const auto dir = test::scratch_dir("bad-gltf");
+  write_text(dir / "empty.gltf", "");
+  expect_error(dir / "empty.gltf", "empty");
+  write_text(dir / "json.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [");
+  expect_error(dir / "json.gltf");
+  TriMesh tri;
+  tri.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  tri.faces = {Vec3i(0, 1, 2)};
+  save_mesh(tri, dir / "ok.glb", LengthUnit::m);
+  const std::string glb = read_file(dir / "ok.glb");
+  write_text(dir / "trunc.glb", glb.substr(0, glb.size() / 2));
+  expect_error(dir / "trunc.glb");
+  // Out-of-range index: patch the last uint32 index (2) to 9.
+  std::string bad = glb;
+  const uint32_t two = 2, nine = 9;
+  const std::size_t pos = bad.rfind(std::string(reinterpret_cast<const char*>(&two), 4));
+  ASSERT_NE(pos, std::string::npos);
+  std::memcpy(bad.data() + pos, &nine, 4);
+  write_text(dir / "range.glb", bad);
+  expect_error(dir / "range.glb", "index");
+}
+
+TEST(MeshIOMalformed, RandomBytesNeverCrash) {
+  const auto dir = test::scratch_dir("random");
+  Rng rng(1234);
+  for (const char* ext : {".obj", ".ply", ".gltf", ".glb"})
+    for (int trial = 0; trial < 8; ++trial) {
+      std::string bytes(64 + rng.below(2048), '\0');
+      for (char& c : bytes) c = char(rng.below(256));
+      if (trial % 2) bytes = std::string(ext == std::string(".ply") ? "ply\n" : "glTF") + bytes;
+      const auto p = dir / (std::string("r") + std::to_string(trial) + ext);
+      write_text(p, bytes);
+      expect_error(p);
+    }
+}
+
+TEST(MeshIOMalformed, UnknownExtension) {
+  const auto dir = test::scratch_dir("ext");
+  write_text(dir / "m.stl", "solid x\n");
+  expect_error(dir / "m.stl", "extension");
+  EXPECT_THROW(save_mesh(make_cube(), dir / "m.fbx", LengthUnit::m), Error);
+}
+
+TEST(MeshIO, WritesAreAtomic) {
+  const auto dir = test::scratch_dir("atomic");
+  save_mesh(make_cube(), dir / "c.ply", LengthUnit::m);
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename(), "c.ply");  // no temp files left behind
+}

@@ -1,0 +1,136 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include "follicle/core/atomic_file.hpp"
+#include "follicle/image/image_io.hpp"
+#include "testing/testing.hpp"
+
+using namespace follicle;
+using namespace follicle::image;
+
+namespace {
+ImageRGBA8 pattern_rgba(int w, int h) {
+  ImageRGBA8 img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 4; ++c) img.at(x, y, c) = uint8_t((x * 37 + y * 11 + c * 73) & 255);
+  return img;
+}
+void write_bytes(const std::filesystem::path& p, const std::string& s) {
+  std::ofstream(p, std::ios::binary).write(s.data(), std::streamsize(s.size()));
+}
+}  // namespace
+
+TEST(ImageIo, PngRgbaRoundTripIsExact) {
+  auto dir = test::scratch_dir("png_rgba");
+  const ImageRGBA8 img = pattern_rgba(37, 23);
+  write_png(dir / "a.png", img);
+  EXPECT_EQ(read_png_rgba(dir / "a.png"), img);
+}
+
+TEST(ImageIo, PngGrayRoundTripIsExactAndTopRowFirst) {
+  auto dir = test::scratch_dir("png_gray");
+  ImageGray8 img(5, 4);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 5; ++x) img.at(x, y) = uint8_t(y * 50 + x);
+  write_png(dir / "g.png", img);
+  const ImageGray8 back = read_png_gray(dir / "g.png");
+  EXPECT_EQ(back, img);
+  // A gray PNG read as RGBA replicates the value and sets alpha to 255.
+  const ImageRGBA8 rgba = read_png_rgba(dir / "g.png");
+  EXPECT_EQ(rgba.at(4, 3, 0), img.at(4, 3));
+  EXPECT_EQ(rgba.at(4, 3, 2), img.at(4, 3));
+  EXPECT_EQ(rgba.at(4, 3, 3), 255);
+}
+
+TEST(ImageIo, PngRgbRoundTrip) {
+  auto dir = test::scratch_dir("png_rgb");
+  ImageRGB8 img(3, 2);
+  for (std::size_t i = 0; i < img.storage().size(); ++i) img.storage()[i] = uint8_t(i * 13);
+  write_png(dir / "c.png", img);
+  const ImageRGBA8 back = read_png_rgba(dir / "c.png");
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x)
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(back.at(x, y, c), img.at(x, y, c));
+}
+
+TEST(ImageIo, ExrGrayRoundTripIsBitExact) {
+  auto dir = test::scratch_dir("exr_gray");
+  ImageF img(17, 9);
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 17; ++x) img.at(x, y) = std::ldexp(float(x - 8) / 3.f, y - 4) + 1e-7f * y;
+  img.at(0, 0) = std::numeric_limits<float>::denorm_min();
+  img.at(1, 0) = -0.0f;
+  write_exr(dir / "h.exr", img);
+  const ImageF back = read_exr_gray(dir / "h.exr");
+  ASSERT_EQ(back.width(), 17);
+  ASSERT_EQ(back.height(), 9);
+  EXPECT_EQ(std::memcmp(back.data(), img.data(), img.storage().size() * sizeof(float)), 0);
+}
+
+TEST(ImageIo, ExrRgbAndRgbaRoundTrip) {
+  auto dir = test::scratch_dir("exr_rgba");
+  ImageRGBAF a(6, 5);
+  ImageRGBF b(6, 5);
+  for (std::size_t i = 0; i < a.storage().size(); ++i) a.storage()[i] = float(i) * 0.123f - 2.f;
+  for (std::size_t i = 0; i < b.storage().size(); ++i) b.storage()[i] = float(i) * -0.77f;
+  write_exr(dir / "a.exr", a);
+  write_exr(dir / "b.exr", b);
+  EXPECT_EQ(read_exr_rgba(dir / "a.exr"), a);
+  const ImageRGBAF bb = read_exr_rgba(dir / "b.exr");
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 6; ++x) {
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(bb.at(x, y, c), b.at(x, y, c));
+      EXPECT_EQ(bb.at(x, y, 3), 1.0f);  // missing alpha reads as opaque
+    }
+}
+
+TEST(ImageIo, MissingFileIsError) {
+  auto dir = test::scratch_dir("missing");
+  EXPECT_THROW(read_png_rgba(dir / "nope.png"), Error);
+  EXPECT_THROW(read_exr_gray(dir / "nope.exr"), Error);
+}
+
+TEST(ImageIo, EmptyGarbageAndTruncatedPngAreErrors) {
+  auto dir = test::scratch_dir("bad_png");
+  write_bytes(dir / "empty.png", "");
+  EXPECT_THROW(read_png_rgba(dir / "empty.png"), Error);
+  std::string garbage;
+  for (int i = 0; i < 1000; ++i) garbage.push_back(char((i * 7919 + 13) & 255));
+  write_bytes(dir / "garbage.png", garbage);
+  EXPECT_THROW(read_png_rgba(dir / "garbage.png"), Error);
+  write_png(dir / "good.png", pattern_rgba(64, 64));
+  const std::string full = read_file(dir / "good.png");
+  for (std::size_t keep : {std::size_t(8), std::size_t(40), full.size() / 2, full.size() - 20}) {
+    write_bytes(dir / "trunc.png", full.substr(0, keep));
+    EXPECT_THROW(read_png_rgba(dir / "trunc.png"), Error) << "kept " << keep << " bytes";
+  }
+}
+
+TEST(ImageIo, GarbageAndTruncatedExrAreErrors) {
+  auto dir = test::scratch_dir("bad_exr");
+  std::string garbage;
+  for (int i = 0; i < 1000; ++i) garbage.push_back(char((i * 131 + 7) & 255));
+  write_bytes(dir / "garbage.exr", garbage);
+  EXPECT_THROW(read_exr_gray(dir / "garbage.exr"), Error);
+  write_bytes(dir / "empty.exr", "");
+  EXPECT_THROW(read_exr_rgba(dir / "empty.exr"), Error);
+  ImageF img(64, 64, 0.5f);
+  write_exr(dir / "good.exr", img);
+  const std::string full = read_file(dir / "good.exr");
+  for (std::size_t keep : {std::size_t(10), std::size_t(200), full.size() / 2, full.size() - 10}) {
+    write_bytes(dir / "trunc.exr", full.substr(0, keep));
+    EXPECT_THROW(read_exr_gray(dir / "trunc.exr"), Error) << "kept " << keep << " bytes";
+  }
+}
+
+TEST(ImageIo, WritingEmptyImageIsErrorAndLeavesNoFile) {
+  auto dir = test::scratch_dir("empty_write");
+  EXPECT_THROW(write_png(dir / "e.png", ImageRGBA8{}), Error);
+  EXPECT_THROW(write_exr(dir / "e.exr", ImageF{}), Error);
+  EXPECT_FALSE(std::filesystem::exists(dir / "e.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "e.exr"));
+}
