@@ -16,11 +16,13 @@ void run(benchmark::State& state, const char* name, const Sizes& sizes, int thre
   Context ctx(threads);
   auto inst = w.make(ctx, resolve_sizes(w, sizes));
   for (auto _ : state) inst->run_once();
-  state.counters["items_per_s"] =
-      benchmark::Counter(inst->items_per_iter() * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["items_per_s"] = benchmark::Counter(
+      inst->items_per_iter() * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-void BM_MeshLoad(benchmark::State& state) { run(state, "mesh-load", {}, int(state.range(0))); }
+void BM_MeshLoad(benchmark::State& state) {
+  run(state, "mesh-load", {}, int(state.range(0)));
+}
 void BM_ClosestPoint(benchmark::State& state) {
   run(state, "closest-point", {{"queries", double(state.range(0))}}, int(state.range(1)));
 }
@@ -32,4 +34,7 @@ void BM_NeighbourSearch(benchmark::State& state) {
 
 BENCHMARK(BM_MeshLoad)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClosestPoint)->Args({1000000, 1})->Args({1000000, 2})->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_NeighbourSearch)->Args({1000000, 1})->Args({1000000, 2})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_NeighbourSearch)
+    ->Args({1000000, 1})
+    ->Args({1000000, 2})
+    ->Unit(benchmark::kMillisecond);

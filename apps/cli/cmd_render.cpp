@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "follicle/core/log.hpp"
 #include "follicle/core/progress.hpp"
 #include "follicle/image/image_io.hpp"
 #include "follicle/render/renderer.hpp"

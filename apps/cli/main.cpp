@@ -86,11 +86,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
-    return app.exit(e);  // --help / --version
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
+    return app.exit(e);  // --help / --version (CallForHelp derives from Success)
   } catch (const CLI::ParseError& e) {
     return report(std::string(e.what()) + " (run 'follicle --help')", 2);
   }

@@ -80,7 +80,8 @@ class ClosestPointQueries : public WorkloadInstance {
 
 class NeighbourSearch : public WorkloadInstance {
  public:
-  NeighbourSearch(const Context& ctx, std::size_t n, double radius) : m_ctx(ctx), m_radius(float(radius)) {
+  NeighbourSearch(const Context& ctx, std::size_t n, double radius)
+      : m_ctx(ctx), m_radius(float(radius)) {
     // Uniform random particles in a unit cube.
     m_points.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -109,28 +110,34 @@ class NeighbourSearch : public WorkloadInstance {
 }  // namespace
 
 void add_geom_workloads(std::vector<Workload>& out) {
-  out.push_back({"mesh-load", "load the default head OBJ (8838 vertices) and convert mm to m", {},
-                 "meshes/s", [](const Context&, const Sizes&) {
+  out.push_back({"mesh-load",
+                 "load the default head OBJ (8838 vertices) and convert mm to m",
+                 {},
+                 "meshes/s",
+                 [](const Context&, const Sizes&) {
                    return std::unique_ptr<WorkloadInstance>(new MeshLoad());
                  }});
   out.push_back({"closest-point",
                  "closest surface point on the default head (Embree) for random points around it",
-                 {{"queries", 1e6}}, "queries/s", [](const Context& ctx, const Sizes& s) {
+                 {{"queries", 1e6}},
+                 "queries/s",
+                 [](const Context& ctx, const Sizes& s) {
                    return std::unique_ptr<WorkloadInstance>(
                        new ClosestPointQueries(ctx, size_of(s, "queries", 1)));
                  }});
-  // Radius for ~12 neighbours among n uniform points in a unit cube: (4/3) pi r^3 n = 12.
-  const double r12 = std::cbrt(12.0 * 3.0 / (4.0 * kPi * 1e6));
   out.push_back({"neighbour-search",
                  "uniform-grid build + fixed-radius neighbour lists over random particles in a "
-                 "unit cube (default radius gives ~12 neighbours at 1M particles)",
-                 {{"particles", 1e6}, {"radius", r12}}, "particles/s",
+                 "unit cube; radius 0 = automatic, ~12 neighbours per particle",
+                 {{"particles", 1e6}, {"radius", 0.0}},
+                 "particles/s",
                  [](const Context& ctx, const Sizes& s) {
-                   const double r = s.at("radius");
-                   if (!(r > 0) || !std::isfinite(r))
-                     fail("size 'radius' = {} must be a positive number", r);
-                   return std::unique_ptr<WorkloadInstance>(
-                       new NeighbourSearch(ctx, size_of(s, "particles", 1), r));
+                   const std::size_t n = size_of(s, "particles", 1);
+                   double r = s.at("radius");
+                   if (!(r >= 0) || !std::isfinite(r))
+                     fail("size 'radius' = {} must be a number >= 0 (0 = automatic)", r);
+                   // ~12 neighbours among n uniform points in a unit cube: (4/3) pi r^3 n = 12.
+                   if (r == 0) r = std::cbrt(12.0 * 3.0 / (4.0 * kPi * double(n)));
+                   return std::unique_ptr<WorkloadInstance>(new NeighbourSearch(ctx, n, r));
                  }});
 }
 

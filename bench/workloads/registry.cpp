@@ -10,11 +10,13 @@ namespace follicle::workloads {
 // registration, no globals).
 void add_geom_workloads(std::vector<Workload>& out);
 void add_render_workloads(std::vector<Workload>& out);
+void add_fine_workloads(std::vector<Workload>& out);
 
 std::vector<Workload> all_workloads() {
   std::vector<Workload> out;
   add_geom_workloads(out);
   add_render_workloads(out);
+  add_fine_workloads(out);
   return out;
 }
 

@@ -24,8 +24,10 @@ std::filesystem::path find_head_dir() {
     if (!p.has_parent_path() || p.parent_path() == p) break;
     p = p.parent_path();
   }
-  fail("render-head: cannot find data/{}/head.obj (run from the repository or set FOLLICLE_DATA_DIR)",
-       rel.string());
+  fail(
+      "render-head: cannot find data/{}/head.obj (run from the repository or set "
+      "FOLLICLE_DATA_DIR)",
+      rel.string());
 }
 
 class RenderHead final : public WorkloadInstance {

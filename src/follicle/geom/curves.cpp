@@ -63,8 +63,8 @@ double CubicBezier<D>::closest_parameter(const V& q, double* distance) const {
 namespace {
 template <class F>
 double gauss5(const F& f, double a, double b) {
-  static constexpr double x[5] = {0.0, 0.5384693101056831, -0.5384693101056831,
-                                  0.9061798459386640, -0.9061798459386640};
+  static constexpr double x[5] = {0.0, 0.5384693101056831, -0.5384693101056831, 0.9061798459386640,
+                                  -0.9061798459386640};
   static constexpr double w[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665,
                                   0.2369268850561891, 0.2369268850561891};
   const double c = 0.5 * (a + b), h = 0.5 * (b - a);
@@ -99,8 +99,10 @@ double CubicBezier<D>::parameter_at_length(double s) const {
   for (int it = 0; it < 50; ++it) {
     const double f = arc_length(0, t) - s;
     if (std::abs(f) < 1e-12 * std::max(1.0, total)) break;
-    if (f > 0) hi = t;
-    else lo = t;
+    if (f > 0)
+      hi = t;
+    else
+      lo = t;
     const double sp = derivative(t).norm();
     double tn = sp > 0 ? t - f / sp : 0.5 * (lo + hi);
     if (!(tn > lo && tn < hi)) tn = 0.5 * (lo + hi);
@@ -148,7 +150,8 @@ CatmullRom<D>::CatmullRom(std::vector<V> points, double alpha, bool closed)
     if (!q.allFinite()) fail("CatmullRom: control point is not finite");
   const std::size_t n = m_pts.size();
   auto P = [&](std::ptrdiff_t i) -> V {
-    if (m_closed) return m_pts[std::size_t((i % std::ptrdiff_t(n) + std::ptrdiff_t(n)) % std::ptrdiff_t(n))];
+    if (m_closed)
+      return m_pts[std::size_t((i % std::ptrdiff_t(n) + std::ptrdiff_t(n)) % std::ptrdiff_t(n))];
     if (i < 0) return 2 * m_pts[0] - m_pts[1];
     if (i >= std::ptrdiff_t(n)) return 2 * m_pts[n - 1] - m_pts[n - 2];
     return m_pts[std::size_t(i)];

@@ -85,8 +85,8 @@ void NeighbourGrid::for_each_within(const Vec3f& p, float r, F&& f) const {
   const float r2 = r * r;
   for (int z = z0; z <= z1; ++z)
     for (int y = y0; y <= y1; ++y) {
-      const std::size_t row = (std::size_t(z) * std::size_t(m_dim[1]) + std::size_t(y)) *
-                              std::size_t(m_dim[0]);
+      const std::size_t row =
+          (std::size_t(z) * std::size_t(m_dim[1]) + std::size_t(y)) * std::size_t(m_dim[0]);
       const uint32_t b = m_cell_start[row + std::size_t(x0)];
       const uint32_t e = m_cell_start[row + std::size_t(x1) + 1];
       for (uint32_t k = b; k < e; ++k) {

@@ -47,8 +47,9 @@ std::vector<SpringEdge> harmonic_spring_weights(const TriMesh& mesh) {
   const double floor = 1e-6 * (w.empty() ? 1.0 : total / double(w.size()));
   for (const auto& [key, k] : w)
     out.push_back({int(key >> 32), int(key & 0xffffffffu), std::max(k, floor)});
-  std::sort(out.begin(), out.end(),
-            [](const SpringEdge& x, const SpringEdge& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
+  std::sort(out.begin(), out.end(), [](const SpringEdge& x, const SpringEdge& y) {
+    return x.i != y.i ? x.i < y.i : x.j < y.j;
+  });
   return out;
 }
 
@@ -78,7 +79,8 @@ HarmonicSolver::HarmonicSolver(const TriMesh& mesh, const std::vector<int>& fixe
   }
   for (const Vec3i& f : mesh.faces)
     for (int k = 0; k < 3; ++k)
-      if (f[k] < 0 || f[k] >= m->n) fail("harmonic map: face references vertex {} of {}", f[k], m->n);
+      if (f[k] < 0 || f[k] >= m->n)
+        fail("harmonic map: face references vertex {} of {}", f[k], m->n);
   const auto edges = harmonic_spring_weights(mesh);
   // Free vertices reachable from a fixed vertex (others would make the system singular).
   std::vector<std::vector<int>> adj(std::size_t(m->n));
@@ -100,7 +102,8 @@ HarmonicSolver::HarmonicSolver(const TriMesh& mesh, const std::vector<int>& fixe
   }
   m->free_index.assign(std::size_t(m->n), -1);
   for (int v = 0; v < m->n; ++v)
-    if (reach[std::size_t(v)] && m->fixed_slot[std::size_t(v)] < 0) m->free_index[std::size_t(v)] = m->nfree++;
+    if (reach[std::size_t(v)] && m->fixed_slot[std::size_t(v)] < 0)
+      m->free_index[std::size_t(v)] = m->nfree++;
   std::vector<Eigen::Triplet<double>> tff, tfb;
   tff.reserve(edges.size() * 2 + std::size_t(m->nfree));
   std::vector<double> diag(std::size_t(m->nfree), 0.0);
@@ -135,11 +138,13 @@ HarmonicSolver& HarmonicSolver::operator=(HarmonicSolver&&) noexcept = default;
 
 Eigen::MatrixXd HarmonicSolver::solve(const Eigen::MatrixXd& fixed_values) const {
   if (fixed_values.rows() != Eigen::Index(m->fixed.size()))
-    fail("harmonic map: {} fixed values for {} fixed vertices", fixed_values.rows(), m->fixed.size());
+    fail("harmonic map: {} fixed values for {} fixed vertices", fixed_values.rows(),
+         m->fixed.size());
   if (!fixed_values.allFinite()) fail("harmonic map: fixed values are not all finite");
   const Eigen::Index cols = fixed_values.cols();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(m->n, cols);
-  for (std::size_t s = 0; s < m->fixed.size(); ++s) out.row(m->fixed[s]) = fixed_values.row(Eigen::Index(s));
+  for (std::size_t s = 0; s < m->fixed.size(); ++s)
+    out.row(m->fixed[s]) = fixed_values.row(Eigen::Index(s));
   if (m->nfree == 0) return out;
   const Eigen::MatrixXd rhs = m->Lfb * fixed_values;  // sum_j k_ij x_j over fixed neighbours
   const Eigen::MatrixXd x = m->ldlt.solve(rhs);
@@ -159,7 +164,8 @@ Eigen::MatrixXd harmonic_interpolate(const TriMesh& mesh, const std::vector<int>
 
 std::vector<Vec2> per_vertex_uvs(const TriMesh& mesh, double tolerance) {
   if (!mesh.has_uvs()) return {};
-  std::vector<Vec2> uv(mesh.positions.size(), Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
+  std::vector<Vec2> uv(mesh.positions.size(),
+                       Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
   for (std::size_t f = 0; f < mesh.faces.size(); ++f)
     for (int k = 0; k < 3; ++k) {
       const auto v = std::size_t(mesh.faces[f][k]);
@@ -177,7 +183,8 @@ std::vector<Vec2> per_vertex_uvs(const TriMesh& mesh, double tolerance) {
 
 UvQuality evaluate_uv_quality(const TriMesh& mesh, const std::vector<Vec2>& uv) {
   UvQuality q;
-  if (uv.size() != mesh.positions.size()) fail("uv quality: {} UVs for {} vertices", uv.size(), mesh.positions.size());
+  if (uv.size() != mesh.positions.size())
+    fail("uv quality: {} UVs for {} vertices", uv.size(), mesh.positions.size());
   const std::size_t nf = mesh.faces.size();
   std::vector<double> sa(nf), a3(nf);
   double pos = 0, neg = 0, sum_uv = 0, sum_3d = 0;
@@ -205,7 +212,8 @@ UvQuality evaluate_uv_quality(const TriMesh& mesh, const std::vector<Vec2>& uv) 
     // Jacobian of the affine map from the triangle's 3D frame to UV.
     const Vec3i& t = mesh.faces[f];
     const Vec3 p0 = mesh.positions[std::size_t(t[0])];
-    const Vec3 x1 = mesh.positions[std::size_t(t[1])] - p0, x2 = mesh.positions[std::size_t(t[2])] - p0;
+    const Vec3 x1 = mesh.positions[std::size_t(t[1])] - p0,
+               x2 = mesh.positions[std::size_t(t[2])] - p0;
     const Vec3 ex = x1.normalized();
     const Vec3 ey = (x2 - x2.dot(ex) * ex).normalized();
     Eigen::Matrix2d P, U;
@@ -255,7 +263,8 @@ std::vector<std::vector<int>> boundary_loops(const TriMesh& mesh) {
   auto len = [&](const std::vector<int>& l) {
     double s = 0;
     for (std::size_t i = 0; i < l.size(); ++i)
-      s += (mesh.positions[std::size_t(l[(i + 1) % l.size()])] - mesh.positions[std::size_t(l[i])]).norm();
+      s += (mesh.positions[std::size_t(l[(i + 1) % l.size()])] - mesh.positions[std::size_t(l[i])])
+               .norm();
     return s;
   };
   std::stable_sort(loops.begin(), loops.end(),
@@ -265,15 +274,19 @@ std::vector<std::vector<int>> boundary_loops(const TriMesh& mesh) {
 
 namespace {
 
-double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+double cross2(const Vec2& a, const Vec2& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 // Boundary relaxation (§2.4: "we move some vertices so that the boundary becomes less concave"):
 // reflex vertices of the outer loop move toward the midpoint of their loop neighbours.
-int relax_boundary(std::vector<Vec2>& uv, const std::vector<int>& loop, int iterations, double step) {
+int relax_boundary(std::vector<Vec2>& uv, const std::vector<int>& loop, int iterations,
+                   double step) {
   const std::size_t n = loop.size();
   if (n < 4) return 0;
   double area2 = 0;
-  for (std::size_t i = 0; i < n; ++i) area2 += cross2(uv[std::size_t(loop[i])], uv[std::size_t(loop[(i + 1) % n])]);
+  for (std::size_t i = 0; i < n; ++i)
+    area2 += cross2(uv[std::size_t(loop[i])], uv[std::size_t(loop[(i + 1) % n])]);
   const double orient = area2 >= 0 ? 1.0 : -1.0;
   std::vector<char> moved(n, 0);
   for (int it = 0; it < iterations; ++it) {
@@ -305,7 +318,8 @@ void fit_unit_square(std::vector<Vec2>& uv) {
 }  // namespace
 
 std::vector<Vec2> harmonic_parameterize(const TriMesh& mesh, const std::vector<Vec2>& initial_uv,
-                                        const HarmonicMapParams& params, HarmonicMapReport* report) {
+                                        const HarmonicMapParams& params,
+                                        HarmonicMapReport* report) {
   params.validate();
   if (initial_uv.size() != mesh.positions.size())
     fail("harmonic map: {} initial UVs for {} vertices", initial_uv.size(), mesh.positions.size());
@@ -313,14 +327,19 @@ std::vector<Vec2> harmonic_parameterize(const TriMesh& mesh, const std::vector<V
   rep.before = evaluate_uv_quality(mesh, initial_uv);
   std::vector<Vec2> uv = initial_uv;
   const auto loops = boundary_loops(mesh);
-  if (loops.empty()) fail("harmonic map: the mesh has no boundary (a closed surface needs cutting)");
+  if (loops.empty())
+    fail("harmonic map: the mesh has no boundary (a closed surface needs cutting)");
   const std::vector<int>& outer = loops.front();
   if (params.circle_boundary) {
     double total = 0;
     std::vector<double> acc(outer.size(), 0.0);
     for (std::size_t i = 1; i < outer.size(); ++i)
-      acc[i] = total += (mesh.positions[std::size_t(outer[i])] - mesh.positions[std::size_t(outer[i - 1])]).norm();
-    total += (mesh.positions[std::size_t(outer.front())] - mesh.positions[std::size_t(outer.back())]).norm();
+      acc[i] = total +=
+          (mesh.positions[std::size_t(outer[i])] - mesh.positions[std::size_t(outer[i - 1])])
+              .norm();
+    total +=
+        (mesh.positions[std::size_t(outer.front())] - mesh.positions[std::size_t(outer.back())])
+            .norm();
     for (std::size_t i = 0; i < outer.size(); ++i) {
       const double a = 2 * kPi * acc[i] / total;
       uv[std::size_t(outer[i])] = Vec2(0.5 + 0.5 * std::cos(a), 0.5 + 0.5 * std::sin(a));
@@ -329,7 +348,8 @@ std::vector<Vec2> harmonic_parameterize(const TriMesh& mesh, const std::vector<V
     rep.relaxed_vertices = relax_boundary(uv, outer, params.relax_iterations, params.relax_step);
   }
   Eigen::MatrixXd fixed(Eigen::Index(outer.size()), 2);
-  for (std::size_t i = 0; i < outer.size(); ++i) fixed.row(Eigen::Index(i)) = uv[std::size_t(outer[i])].transpose();
+  for (std::size_t i = 0; i < outer.size(); ++i)
+    fixed.row(Eigen::Index(i)) = uv[std::size_t(outer[i])].transpose();
   const Eigen::MatrixXd x = harmonic_interpolate(mesh, outer, fixed);
   for (std::size_t v = 0; v < uv.size(); ++v) uv[v] = x.row(Eigen::Index(v)).transpose();
   if (params.fit_unit_square) fit_unit_square(uv);

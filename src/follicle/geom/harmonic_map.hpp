@@ -65,11 +65,11 @@ UvQuality evaluate_uv_quality(const TriMesh& mesh, const std::vector<Vec2>& vert
 std::vector<std::vector<int>> boundary_loops(const TriMesh& mesh);
 
 struct HarmonicMapParams {
-  bool keep_own_uvs = true;        // keep the mesh's UVs when they are one-to-one
-  int relax_iterations = 50;       // boundary relaxation sweeps (concave -> less concave)
-  double relax_step = 0.5;         // fraction of the way to the neighbour midpoint per sweep
-  bool circle_boundary = false;    // fix the outer loop on a circle instead of its projection
-  bool fit_unit_square = true;     // scale/translate the result into [0,1]^2 (aspect kept)
+  bool keep_own_uvs = true;      // keep the mesh's UVs when they are one-to-one
+  int relax_iterations = 50;     // boundary relaxation sweeps (concave -> less concave)
+  double relax_step = 0.5;       // fraction of the way to the neighbour midpoint per sweep
+  bool circle_boundary = false;  // fix the outer loop on a circle instead of its projection
+  bool fit_unit_square = true;   // scale/translate the result into [0,1]^2 (aspect kept)
   template <class V>
   void visit(V&& v) {
     v("keep_own_uvs", keep_own_uvs, ParamInfo{"keep one-to-one mesh UVs", ""});

@@ -33,7 +33,8 @@ namespace fs = std::filesystem;
 
 std::string lower_ext(const fs::path& p) {
   std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::transform(e.begin(), e.end(), e.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
   return e;
 }
 
@@ -139,8 +140,8 @@ void validate_obj(const fs::path& path, const std::string& text) {
                       names[c], part);
             if (idx[c] < 0 && -idx[c] > counts[c])
               fail_at(at_line(path, line_no),
-                      "face {} index {} is out of range: only {} defined so far", names[c],
-                      idx[c], counts[c]);
+                      "face {} index {} is out of range: only {} defined so far", names[c], idx[c],
+                      counts[c]);
           }
           if (slash == std::string_view::npos) break;
           t = t.substr(slash + 1);
@@ -157,17 +158,16 @@ void validate_obj(const fs::path& path, const std::string& text) {
   }
   for (const Deferred& d : deferred) {
     if (d.v > nv)
-      fail_at(at_line(path, d.line), "face vertex index {} is out of range: the file has {}",
-              d.v, nv);
+      fail_at(at_line(path, d.line), "face vertex index {} is out of range: the file has {}", d.v,
+              nv);
     if (d.vt > nvt)
       fail_at(at_line(path, d.line),
               "face texture coordinate index {} is out of range: the file has {}", d.vt, nvt);
     if (d.vn > nvn)
-      fail_at(at_line(path, d.line), "face normal index {} is out of range: the file has {}",
-              d.vn, nvn);
+      fail_at(at_line(path, d.line), "face normal index {} is out of range: the file has {}", d.vn,
+              nvn);
   }
-  if (nf == 0)
-    fail_at(path.string(), "no faces found ({} vertices): not a triangle mesh OBJ", nv);
+  if (nf == 0) fail_at(path.string(), "no faces found ({} vertices): not a triangle mesh OBJ", nv);
 }
 
 TriMesh load_obj(const fs::path& path) {
@@ -184,8 +184,8 @@ TriMesh load_obj(const fs::path& path) {
   m.name = path.stem().string();
   m.positions.resize(attrib.vertices.size() / 3);
   for (std::size_t i = 0; i < m.positions.size(); ++i)
-    m.positions[i] = Vec3(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
-                          attrib.vertices[3 * i + 2]);
+    m.positions[i] =
+        Vec3(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
   m.uvs.resize(attrib.texcoords.size() / 2);
   for (std::size_t i = 0; i < m.uvs.size(); ++i)
     m.uvs[i] = Vec2(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
@@ -253,11 +253,11 @@ enum class PlyType { i8, u8, i16, u16, i32, u32, f32, f64 };
 
 bool ply_type(std::string_view s, PlyType& t) {
   static constexpr std::pair<std::string_view, PlyType> table[] = {
-      {"char", PlyType::i8},     {"int8", PlyType::i8},     {"uchar", PlyType::u8},
-      {"uint8", PlyType::u8},    {"short", PlyType::i16},   {"int16", PlyType::i16},
-      {"ushort", PlyType::u16},  {"uint16", PlyType::u16},  {"int", PlyType::i32},
-      {"int32", PlyType::i32},   {"uint", PlyType::u32},    {"uint32", PlyType::u32},
-      {"float", PlyType::f32},   {"float32", PlyType::f32}, {"double", PlyType::f64},
+      {"char", PlyType::i8},    {"int8", PlyType::i8},     {"uchar", PlyType::u8},
+      {"uint8", PlyType::u8},   {"short", PlyType::i16},   {"int16", PlyType::i16},
+      {"ushort", PlyType::u16}, {"uint16", PlyType::u16},  {"int", PlyType::i32},
+      {"int32", PlyType::i32},  {"uint", PlyType::u32},    {"uint32", PlyType::u32},
+      {"float", PlyType::f32},  {"float32", PlyType::f32}, {"double", PlyType::f64},
       {"float64", PlyType::f64}};
   for (const auto& [n, v] : table)
     if (n == s) {
@@ -356,17 +356,42 @@ class PlyReader {
     unsigned char b[8];
     std::memcpy(b, m_data.data() + m_pos, n);
     m_pos += n;
-    const bool swap = (m_fmt == PlyFormat::binary_be) == (std::endian::native == std::endian::little);
+    const bool swap =
+        (m_fmt == PlyFormat::binary_be) == (std::endian::native == std::endian::little);
     if (swap) std::reverse(b, b + n);
     switch (t) {
       case PlyType::i8: return double(int8_t(b[0]));
       case PlyType::u8: return double(b[0]);
-      case PlyType::i16: { int16_t v; std::memcpy(&v, b, 2); return v; }
-      case PlyType::u16: { uint16_t v; std::memcpy(&v, b, 2); return v; }
-      case PlyType::i32: { int32_t v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::u32: { uint32_t v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::f32: { float v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::f64: { double v; std::memcpy(&v, b, 8); return v; }
+      case PlyType::i16: {
+        int16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case PlyType::u16: {
+        uint16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case PlyType::i32: {
+        int32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case PlyType::u32: {
+        uint32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case PlyType::f32: {
+        float v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case PlyType::f64: {
+        double v;
+        std::memcpy(&v, b, 8);
+        return v;
+      }
     }
     return 0;
   }
@@ -412,9 +437,12 @@ TriMesh load_ply(const fs::path& path) {
     if (toks[0] == "format") {
       if (toks.size() != 3 || toks[2] != "1.0")
         fail_at(at_line(path, line), "bad format line, expected 'format <kind> 1.0'");
-      if (toks[1] == "ascii") format = PlyFormat::ascii;
-      else if (toks[1] == "binary_little_endian") format = PlyFormat::binary_le;
-      else if (toks[1] == "binary_big_endian") format = PlyFormat::binary_be;
+      if (toks[1] == "ascii")
+        format = PlyFormat::ascii;
+      else if (toks[1] == "binary_little_endian")
+        format = PlyFormat::binary_le;
+      else if (toks[1] == "binary_big_endian")
+        format = PlyFormat::binary_be;
       else
         fail_at(at_line(path, line),
                 "unknown PLY format '{}', expected ascii, binary_little_endian or "
@@ -427,8 +455,7 @@ TriMesh load_ply(const fs::path& path) {
         fail_at(at_line(path, line), "bad element line, expected 'element <name> <count>'");
       elements.push_back({std::string(toks[1]), std::size_t(count), {}});
     } else if (toks[0] == "property") {
-      if (elements.empty())
-        fail_at(at_line(path, line), "property before any element");
+      if (elements.empty()) fail_at(at_line(path, line), "property before any element");
       PlyProperty p;
       if (toks.size() == 5 && toks[1] == "list") {
         p.is_list = true;
@@ -462,7 +489,8 @@ TriMesh load_ply(const fs::path& path) {
   for (const PlyElement& el : elements) {
     // Guard against absurd counts before allocating: each item needs at least one byte/token.
     std::size_t min_item = 0;
-    for (const auto& p : el.props) min_item += p.is_list ? ply_size(p.count_type) : ply_size(p.type);
+    for (const auto& p : el.props)
+      min_item += p.is_list ? ply_size(p.count_type) : ply_size(p.type);
     if (format != PlyFormat::ascii && min_item > 0 && el.count > rd.remaining() / min_item)
       fail_at(file, "element '{}' declares {} items but the file holds at most {} (truncated?)",
               el.name, el.count, rd.remaining() / min_item);
@@ -477,17 +505,24 @@ TriMesh load_ply(const fs::path& path) {
         const std::string& n = el.props[k].name;
         const int ki = int(k);
         if (el.props[k].is_list) continue;
-        if (n == "x") ix = ki;
-        else if (n == "y") iy = ki;
-        else if (n == "z") iz = ki;
-        else if (n == "nx") inx = ki;
-        else if (n == "ny") iny = ki;
-        else if (n == "nz") inz = ki;
-        else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s") iu = ki;
-        else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t") iv = ki;
+        if (n == "x")
+          ix = ki;
+        else if (n == "y")
+          iy = ki;
+        else if (n == "z")
+          iz = ki;
+        else if (n == "nx")
+          inx = ki;
+        else if (n == "ny")
+          iny = ki;
+        else if (n == "nz")
+          inz = ki;
+        else if (n == "u" || n == "s" || n == "texture_u" || n == "texture_s")
+          iu = ki;
+        else if (n == "v" || n == "t" || n == "texture_v" || n == "texture_t")
+          iv = ki;
       }
-      if (ix < 0 || iy < 0 || iz < 0)
-        fail_at(file, "vertex element lacks x, y and z properties");
+      if (ix < 0 || iy < 0 || iz < 0) fail_at(file, "vertex element lacks x, y and z properties");
       const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
       const bool uvs = iu >= 0 && iv >= 0;
       m.positions.resize(el.count);
@@ -504,8 +539,7 @@ TriMesh load_ply(const fs::path& path) {
           } else {
             vals[k] = rd.read(p.type, fmt::format("vertex {} property '{}'", i, p.name));
             if (!std::isfinite(vals[k]))
-              fail_at(rd.where(), "vertex {} property '{}' is not finite ({})", i, p.name,
-                      vals[k]);
+              fail_at(rd.where(), "vertex {} property '{}' is not finite ({})", i, p.name, vals[k]);
           }
         }
         m.positions[i] = Vec3(vals[std::size_t(ix)], vals[std::size_t(iy)], vals[std::size_t(iz)]);
@@ -537,8 +571,8 @@ TriMesh load_ply(const fs::path& path) {
             const double idx = rd.read(p.type, fmt::format("face {} index", i));
             if (int(k) == ilist) {
               if (!(idx >= 0 && idx < double(nv)))
-                fail_at(rd.where(), "face {} references vertex {}, expected an index in [0, {})",
-                        i, idx, nv);
+                fail_at(rd.where(), "face {} references vertex {}, expected an index in [0, {})", i,
+                        idx, nv);
               poly.push_back(int(idx));
             }
           }
@@ -645,7 +679,8 @@ std::vector<double> read_accessor(const fs::path& path, const tinygltf::Model& m
   const auto& buf = model.buffers[std::size_t(bv.buffer)].data;
   const int csize = tinygltf::GetComponentSizeInBytes(uint32_t(acc.componentType));
   const int ncomp = tinygltf::GetNumComponentsInType(uint32_t(acc.type));
-  if (csize <= 0 || ncomp <= 0) fail_at(file, "{} accessor {} has a bad component type", what, index);
+  if (csize <= 0 || ncomp <= 0)
+    fail_at(file, "{} accessor {} has a bad component type", what, index);
   const bool is_float = acc.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
   if (!is_float && !allow_int && !acc.normalized)
     fail_at(file, "{} accessor {} must be float or normalized integers", what, index);
@@ -655,10 +690,9 @@ std::vector<double> read_accessor(const fs::path& path, const tinygltf::Model& m
   if (bv.byteOffset > buf.size() || bv.byteLength > buf.size() - bv.byteOffset)
     fail_at(file, "{} bufferView {} exceeds its buffer ({} bytes)", what, acc.bufferView,
             buf.size());
-  if (acc.count > 0 &&
-      (acc.byteOffset > bv.byteLength ||
-       (acc.count - 1) > (bv.byteLength - acc.byteOffset) / stride ||
-       acc.byteOffset + (acc.count - 1) * stride + elem > bv.byteLength))
+  if (acc.count > 0 && (acc.byteOffset > bv.byteLength ||
+                        (acc.count - 1) > (bv.byteLength - acc.byteOffset) / stride ||
+                        acc.byteOffset + (acc.count - 1) * stride + elem > bv.byteLength))
     fail_at(file, "{} accessor {} ({} elements) exceeds its bufferView ({} bytes): truncated?",
             what, index, acc.count, bv.byteLength);
   std::vector<double> out(acc.count * std::size_t(ncomp));
@@ -668,12 +702,40 @@ std::vector<double> read_accessor(const fs::path& path, const tinygltf::Model& m
       const unsigned char* p = base + i * stride + std::size_t(c * csize);
       double v = 0;
       switch (acc.componentType) {
-        case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); v = f; break; }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; if (acc.normalized) v /= 255.0; break;
-        case TINYGLTF_COMPONENT_TYPE_BYTE: v = int8_t(*p); if (acc.normalized) v = std::max(v / 127.0, -1.0); break;
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t s; std::memcpy(&s, p, 2); v = s; if (acc.normalized) v /= 65535.0; break; }
-        case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t s; std::memcpy(&s, p, 2); v = s; if (acc.normalized) v = std::max(v / 32767.0, -1.0); break; }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t s; std::memcpy(&s, p, 4); v = s; break; }
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+          float f;
+          std::memcpy(&f, p, 4);
+          v = f;
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+          v = *p;
+          if (acc.normalized) v /= 255.0;
+          break;
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+          v = int8_t(*p);
+          if (acc.normalized) v = std::max(v / 127.0, -1.0);
+          break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+          uint16_t s;
+          std::memcpy(&s, p, 2);
+          v = s;
+          if (acc.normalized) v /= 65535.0;
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+          int16_t s;
+          std::memcpy(&s, p, 2);
+          v = s;
+          if (acc.normalized) v = std::max(v / 32767.0, -1.0);
+          break;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+          uint32_t s;
+          std::memcpy(&s, p, 4);
+          v = s;
+          break;
+        }
         default: fail_at(file, "{} accessor {} has an unsupported component type", what, index);
       }
       if (!std::isfinite(v)) fail_at(file, "{} element {} is not finite", what, i);
@@ -691,7 +753,8 @@ Affine3 node_matrix(const tinygltf::Node& n) {
     xf.matrix() = m;
     return xf;
   }
-  if (n.translation.size() == 3) xf.translate(Vec3(n.translation[0], n.translation[1], n.translation[2]));
+  if (n.translation.size() == 3)
+    xf.translate(Vec3(n.translation[0], n.translation[1], n.translation[2]));
   if (n.rotation.size() == 4)
     xf.rotate(Quat(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]).normalized());
   if (n.scale.size() == 3) xf.scale(Vec3(n.scale[0], n.scale[1], n.scale[2]));
@@ -724,7 +787,8 @@ void append_gltf_mesh(const fs::path& path, const tinygltf::Model& model, int me
     }
     auto tit = prim.attributes.find("TEXCOORD_0");
     if (tit != prim.attributes.end() && all_uvs) {
-      const auto uv = read_accessor(path, model, tit->second, TINYGLTF_TYPE_VEC2, "TEXCOORD_0", false);
+      const auto uv =
+          read_accessor(path, model, tit->second, TINYGLTF_TYPE_VEC2, "TEXCOORD_0", false);
       if (uv.size() / 2 != nv) fail_at(file, "TEXCOORD_0 count differs from POSITION count");
       for (std::size_t i = 0; i < nv; ++i)
         out.uvs.emplace_back(uv[2 * i], 1.0 - uv[2 * i + 1]);  // glTF origin is top-left
@@ -745,8 +809,8 @@ void append_gltf_mesh(const fs::path& path, const tinygltf::Model& model, int me
       for (int k = 0; k < 3; ++k) {
         const double v = idx[t + std::size_t(k)];
         if (!(v >= 0 && v < double(nv)))
-          fail_at(file, "triangle {} references vertex {}, expected an index in [0, {})", t / 3,
-                  v, nv);
+          fail_at(file, "triangle {} references vertex {}, expected an index in [0, {})", t / 3, v,
+                  nv);
         f[k] = base + int(v);
       }
       out.faces.push_back(f);
@@ -789,7 +853,8 @@ TriMesh load_gltf(const fs::path& path, bool binary) {
   };
   if (!model.scenes.empty()) {
     const int si = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (std::size_t(si) >= model.scenes.size()) fail_at(file, "default scene {} does not exist", si);
+    if (std::size_t(si) >= model.scenes.size())
+      fail_at(file, "default scene {} does not exist", si);
     for (int ni : model.scenes[std::size_t(si)].nodes) walk(ni, Affine3::Identity(), 0);
   } else {
     for (std::size_t mi = 0; mi < model.meshes.size(); ++mi)
@@ -846,9 +911,9 @@ void save_gltf(const TriMesh& in, const fs::path& path, bool binary) {
       mn[std::size_t(k)] = i == 0 ? v : std::min(mn[std::size_t(k)], v);
       mx[std::size_t(k)] = i == 0 ? v : std::max(mx[std::size_t(k)], v);
     }
-  const int ipos = add_accessor(model, add_buffer_view(model, pos, TINYGLTF_TARGET_ARRAY_BUFFER),
-                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
-                                m.positions.size());
+  const int ipos =
+      add_accessor(model, add_buffer_view(model, pos, TINYGLTF_TARGET_ARRAY_BUFFER),
+                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, m.positions.size());
   model.accessors[std::size_t(ipos)].minValues = mn;
   model.accessors[std::size_t(ipos)].maxValues = mx;
   prim.attributes["POSITION"] = ipos;
@@ -922,10 +987,14 @@ TriMesh split_uv_seams(const TriMesh& mesh) {
 TriMesh load_mesh(const std::filesystem::path& path, LengthUnit unit) {
   const std::string ext = lower_ext(path);
   TriMesh m;
-  if (ext == ".obj") m = load_obj(path);
-  else if (ext == ".ply") m = load_ply(path);
-  else if (ext == ".gltf") m = load_gltf(path, false);
-  else if (ext == ".glb") m = load_gltf(path, true);
+  if (ext == ".obj")
+    m = load_obj(path);
+  else if (ext == ".ply")
+    m = load_ply(path);
+  else if (ext == ".gltf")
+    m = load_gltf(path, false);
+  else if (ext == ".glb")
+    m = load_gltf(path, true);
   else
     fail_at(path.string(), "unknown mesh extension '{}': expected .obj, .ply, .gltf or .glb", ext);
   const double s = unit_to_metres(unit);
@@ -942,9 +1011,12 @@ void save_mesh(const TriMesh& mesh, const std::filesystem::path& path, LengthUni
   TriMesh m = mesh;
   const double s = unit_to_metres(unit);
   if (s != 1.0) m.scale(1.0 / s);
-  if (ext == ".obj") save_obj(m, path);
-  else if (ext == ".ply") save_ply(m, path, ascii);
-  else save_gltf(m, path, ext == ".glb");
+  if (ext == ".obj")
+    save_obj(m, path);
+  else if (ext == ".ply")
+    save_ply(m, path, ascii);
+  else
+    save_gltf(m, path, ext == ".glb");
 }
 
 }  // namespace follicle::geom

@@ -27,16 +27,17 @@ struct PlanarProjection {
 /// Cylindrical projection about an axis: u = angle/(2 pi) in [0,1) measured from `zero_dir`
 /// (counter-clockwise about `axis`), v = height along `axis` / height_scale.
 struct CylindricalProjection {
-  Vec3 origin = Vec3::Zero();      // a point on the axis [m]
-  Vec3 axis = Vec3::UnitY();       // cylinder axis (v direction)
-  Vec3 zero_dir = Vec3::UnitZ();   // direction of u = 0.5 (the seam is opposite, at u = 0)
-  double height_scale = 1.0;       // [m per texture unit]
+  Vec3 origin = Vec3::Zero();     // a point on the axis [m]
+  Vec3 axis = Vec3::UnitY();      // cylinder axis (v direction)
+  Vec3 zero_dir = Vec3::UnitZ();  // direction of u = 0.5 (the seam is opposite, at u = 0)
+  double height_scale = 1.0;      // [m per texture unit]
   template <class V>
   void visit(V&& v) {
     v("origin", origin, ParamInfo{"point on the axis", "m"});
     v("axis", axis, ParamInfo{"cylinder axis", ""});
     v("zero_dir", zero_dir, ParamInfo{"direction mapped to u = 0.5", ""});
-    v("height_scale", height_scale, ParamInfo{"metres per texture unit along the axis", "m", 1e-9, 1e9});
+    v("height_scale", height_scale,
+      ParamInfo{"metres per texture unit along the axis", "m", 1e-9, 1e9});
   }
   void validate() const;
 };

@@ -66,9 +66,10 @@ std::vector<SurfaceSample> sample_poisson_disc(const Context& ctx, const TriMesh
   const double r = params.min_distance;
   const double want = std::ceil(params.oversampling * sampler.total_area() / (r * r));
   if (want > double(params.max_candidates))
-    fail("sample_poisson_disc: min_distance {} m on {} m^2 needs {} candidates, more than "
-         "max_candidates {}",
-         r, sampler.total_area(), want, params.max_candidates);
+    fail(
+        "sample_poisson_disc: min_distance {} m on {} m^2 needs {} candidates, more than "
+        "max_candidates {}",
+        r, sampler.total_area(), want, params.max_candidates);
   const auto candidates = sample_uniform(ctx, mesh, std::size_t(std::max(1.0, want)), seed);
   // Dart throwing in candidate order (serial: acceptance depends on earlier decisions).
   // Hash grid with cells of edge r: a conflicting sample lies in the 27 surrounding cells.
@@ -84,7 +85,8 @@ std::vector<SurfaceSample> sample_poisson_disc(const Context& ctx, const TriMesh
   const double r2 = r * r;
   for (const SurfaceSample& c : candidates) {
     const Vec3 q = c.point * inv;
-    const Cell cc{int64_t(std::floor(q.x())), int64_t(std::floor(q.y())), int64_t(std::floor(q.z()))};
+    const Cell cc{int64_t(std::floor(q.x())), int64_t(std::floor(q.y())),
+                  int64_t(std::floor(q.z()))};
     bool ok = true;
     for (int64_t dz = -1; dz <= 1 && ok; ++dz)
       for (int64_t dy = -1; dy <= 1 && ok; ++dy)

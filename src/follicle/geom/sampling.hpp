@@ -45,8 +45,10 @@ struct PoissonDiscParams {
   template <class V>
   void visit(V&& v) {
     v("min_distance", min_distance, ParamInfo{"minimum distance between samples", "m", 1e-9, 1e9});
-    v("oversampling", oversampling, ParamInfo{"candidates per min_distance^2 of area", "", 0.1, 1e4});
-    v("max_points", max_points, ParamInfo{"maximum number of samples (0 = unlimited)", "", 0, 1e12});
+    v("oversampling", oversampling,
+      ParamInfo{"candidates per min_distance^2 of area", "", 0.1, 1e4});
+    v("max_points", max_points,
+      ParamInfo{"maximum number of samples (0 = unlimited)", "", 0, 1e12});
     v("max_candidates", max_candidates, ParamInfo{"candidate pool limit", "", 1, 1e10});
   }
   void validate() const { validate_params(*this, "poisson_disc"); }

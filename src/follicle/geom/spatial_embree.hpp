@@ -15,9 +15,9 @@ namespace follicle::geom {
 struct RayHit {
   bool hit = false;
   int face = -1;
-  Vec3 bary = Vec3::Zero();   // weights of the face's three corners (sum 1)
+  Vec3 bary = Vec3::Zero();  // weights of the face's three corners (sum 1)
   double distance = std::numeric_limits<double>::infinity();  // along the ray, in |dir| units
-  Vec3 point = Vec3::Zero();  // origin + distance * dir
+  Vec3 point = Vec3::Zero();                                  // origin + distance * dir
 };
 
 struct ClosestPoint {

@@ -62,7 +62,8 @@ void check_finite(const std::vector<float>& v, const std::string& where, const c
 CyHairFile parse_cyhair(const std::string& bytes, const std::string& where) {
   Reader r{bytes, where};
   r.need(128, "header");
-  if (bytes.compare(0, 4, "HAIR") != 0) fail_at(where, "not a .hair file: expected signature \"HAIR\"");
+  if (bytes.compare(0, 4, "HAIR") != 0)
+    fail_at(where, "not a .hair file: expected signature \"HAIR\"");
   r.pos = 4;
   CyHairFile f;
   f.hair_count = r.get<uint32_t>("hair count");
@@ -137,7 +138,8 @@ TfxFile parse_tfx(const std::string& bytes, const std::string& where) {
   if (v < 2 || v > 64 || (v & (v - 1)) != 0)
     fail_at(where, "vertices per strand {} is not a power of two in [4, 64]", v);
   if (f.num_strands == 0) fail_at(where, "file has no strands");
-  if (f.offset_positions < 160) fail_at(where, "position offset {} lies inside the header", f.offset_positions);
+  if (f.offset_positions < 160)
+    fail_at(where, "position offset {} lies inside the header", f.offset_positions);
   const std::size_t nv = std::size_t(f.num_strands) * v;
   auto section = [&](uint32_t off, std::vector<float>& out, std::size_t n, const char* what) {
     if (off == 0) return;
@@ -245,7 +247,8 @@ StrandSet tfx_to_strands(const TfxFile& f, LengthUnit unit) {
   if (!f.vertex_color.empty()) {
     out.color.resize(out.points.size());
     for (std::size_t i = 0; i < out.points.size(); ++i)
-      out.color[i] = Vec3f(f.vertex_color[4 * i], f.vertex_color[4 * i + 1], f.vertex_color[4 * i + 2]);
+      out.color[i] =
+          Vec3f(f.vertex_color[4 * i], f.vertex_color[4 * i + 1], f.vertex_color[4 * i + 2]);
   }
   if (!f.strand_thickness.empty()) {
     out.radius.resize(out.points.size());
@@ -259,7 +262,8 @@ std::vector<Vec3f> resample_polyline(const Vec3f* pts, std::size_t count, std::s
   std::vector<Vec3f> out(n, count ? pts[0] : Vec3f::Zero());
   if (count < 2 || n < 2) return out;
   std::vector<double> acc(count, 0.0);
-  for (std::size_t i = 1; i < count; ++i) acc[i] = acc[i - 1] + (pts[i] - pts[i - 1]).cast<double>().norm();
+  for (std::size_t i = 1; i < count; ++i)
+    acc[i] = acc[i - 1] + (pts[i] - pts[i - 1]).cast<double>().norm();
   const double L = acc.back();
   std::size_t j = 1;
   for (std::size_t k = 0; k < n; ++k) {
@@ -286,8 +290,8 @@ TfxFile strands_to_tfx(const StrandSet& s, LengthUnit unit, uint32_t verts) {
   for (std::size_t h = 0; h < s.num_strands(); ++h) resample |= s.strand_size(h) != verts;
   for (std::size_t h = 0; h < s.num_strands(); ++h) {
     const Vec3f* p = s.points.data() + s.strand_begin(h);
-    std::vector<Vec3f> r = resample ? resample_polyline(p, s.strand_size(h), verts)
-                                    : std::vector<Vec3f>(p, p + verts);
+    std::vector<Vec3f> r =
+        resample ? resample_polyline(p, s.strand_size(h), verts) : std::vector<Vec3f>(p, p + verts);
     for (uint32_t i = 0; i < verts; ++i) {
       for (int c = 0; c < 3; ++c) f.positions.push_back(r[i][c] * k);
       f.positions.push_back(i == 0 ? 0.0f : 1.0f);
@@ -298,7 +302,8 @@ TfxFile strands_to_tfx(const StrandSet& s, LengthUnit unit, uint32_t verts) {
 
 static std::string lower_ext(const std::filesystem::path& p) {
   std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::transform(e.begin(), e.end(), e.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
   return e;
 }
 
@@ -314,30 +319,40 @@ void save_strands(const StrandSet& s, const std::filesystem::path& path, LengthU
                   uint32_t tfx_verts) {
   const std::string ext = lower_ext(path);
   std::string bytes;
-  if (ext == ".hair") bytes = serialize_cyhair(strands_to_cyhair(s, unit));
-  else if (ext == ".tfx") bytes = serialize_tfx(strands_to_tfx(s, unit, tfx_verts));
-  else if (ext == ".usda") bytes = strands_to_usda(s, unit);
-  else if (ext == ".obj") bytes = strands_to_obj(s, unit);
-  else fail_at(path.string(), "unknown hair file extension \"{}\" (writable: .hair, .tfx, .usda, .obj)", ext);
+  if (ext == ".hair")
+    bytes = serialize_cyhair(strands_to_cyhair(s, unit));
+  else if (ext == ".tfx")
+    bytes = serialize_tfx(strands_to_tfx(s, unit, tfx_verts));
+  else if (ext == ".usda")
+    bytes = strands_to_usda(s, unit);
+  else if (ext == ".obj")
+    bytes = strands_to_obj(s, unit);
+  else
+    fail_at(path.string(),
+            "unknown hair file extension \"{}\" (writable: .hair, .tfx, .usda, .obj)", ext);
   write_file_atomically(path, bytes);
 }
 
 std::string strands_to_usda(const StrandSet& s, LengthUnit unit) {
   const double k = 1.0 / unit_to_metres(unit);
   std::string o;
-  o += fmt::format("#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = {}\n    upAxis = \"Y\"\n)\n\n",
-                   unit_to_metres(unit));
-  o += "def BasisCurves \"Hair\"\n{\n    uniform token type = \"linear\"\n    uniform token wrap = \"nonperiodic\"\n";
+  o += fmt::format(
+      "#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = {}\n    upAxis = \"Y\"\n)\n\n",
+      unit_to_metres(unit));
+  o += "def BasisCurves \"Hair\"\n{\n    uniform token type = \"linear\"\n    uniform token wrap = "
+       "\"nonperiodic\"\n";
   o += "    int[] curveVertexCounts = [";
-  for (std::size_t h = 0; h < s.num_strands(); ++h) o += fmt::format("{}{}", h ? ", " : "", s.strand_size(h));
+  for (std::size_t h = 0; h < s.num_strands(); ++h)
+    o += fmt::format("{}{}", h ? ", " : "", s.strand_size(h));
   o += "]\n    point3f[] points = [";
   for (std::size_t i = 0; i < s.num_points(); ++i)
-    o += fmt::format("{}({:.9g}, {:.9g}, {:.9g})", i ? ", " : "", s.points[i].x() * k, s.points[i].y() * k,
-                     s.points[i].z() * k);
+    o += fmt::format("{}({:.9g}, {:.9g}, {:.9g})", i ? ", " : "", s.points[i].x() * k,
+                     s.points[i].y() * k, s.points[i].z() * k);
   o += "]\n    float[] widths = [";
   const bool has_r = s.radius.size() == s.num_points() && !s.radius.empty();
   if (has_r) {
-    for (std::size_t i = 0; i < s.num_points(); ++i) o += fmt::format("{}{:.9g}", i ? ", " : "", 2 * s.radius[i] * k);
+    for (std::size_t i = 0; i < s.num_points(); ++i)
+      o += fmt::format("{}{:.9g}", i ? ", " : "", 2 * s.radius[i] * k);
     o += "] (\n        interpolation = \"vertex\"\n    )\n";
   } else {
     o += fmt::format("{:.9g}] (\n        interpolation = \"constant\"\n    )\n", 80e-6 * k);
@@ -345,7 +360,8 @@ std::string strands_to_usda(const StrandSet& s, LengthUnit unit) {
   if (s.color.size() == s.num_points() && !s.color.empty()) {
     o += "    color3f[] primvars:displayColor = [";
     for (std::size_t i = 0; i < s.num_points(); ++i)
-      o += fmt::format("{}({:.6g}, {:.6g}, {:.6g})", i ? ", " : "", s.color[i].x(), s.color[i].y(), s.color[i].z());
+      o += fmt::format("{}({:.6g}, {:.6g}, {:.6g})", i ? ", " : "", s.color[i].x(), s.color[i].y(),
+                       s.color[i].z());
     o += "] (\n        interpolation = \"vertex\"\n    )\n";
   }
   o += "}\n";
@@ -354,8 +370,10 @@ std::string strands_to_usda(const StrandSet& s, LengthUnit unit) {
 
 std::string strands_to_obj(const StrandSet& s, LengthUnit unit) {
   const double k = 1.0 / unit_to_metres(unit);
-  std::string o = fmt::format("# Follicle hair strands: {} polylines, units {}\n", s.num_strands(), to_string(unit));
-  for (const auto& p : s.points) o += fmt::format("v {:.9g} {:.9g} {:.9g}\n", p.x() * k, p.y() * k, p.z() * k);
+  std::string o = fmt::format("# Follicle hair strands: {} polylines, units {}\n", s.num_strands(),
+                              to_string(unit));
+  for (const auto& p : s.points)
+    o += fmt::format("v {:.9g} {:.9g} {:.9g}\n", p.x() * k, p.y() * k, p.z() * k);
   for (std::size_t h = 0; h < s.num_strands(); ++h) {
     o += "l";
     for (uint32_t i = s.offsets[h]; i < s.offsets[h + 1]; ++i) o += fmt::format(" {}", i + 1);

@@ -24,11 +24,11 @@ struct CyHairFile {
   float default_thickness = 1.0f, default_transparency = 0.0f;
   std::array<float, 3> default_color{0.5f, 0.5f, 0.5f};
   std::array<char, 88> info{};
-  std::vector<uint16_t> segments;     // hair_count when kSegments
-  std::vector<float> points;          // 3 * point_count
-  std::vector<float> thickness;       // point_count when kThickness
-  std::vector<float> transparency;    // point_count when kTransparency
-  std::vector<float> colors;          // 3 * point_count when kColors
+  std::vector<uint16_t> segments;   // hair_count when kSegments
+  std::vector<float> points;        // 3 * point_count
+  std::vector<float> thickness;     // point_count when kThickness
+  std::vector<float> transparency;  // point_count when kTransparency
+  std::vector<float> colors;        // 3 * point_count when kColors
 };
 CyHairFile parse_cyhair(const std::string& bytes, const std::string& where);
 std::string serialize_cyhair(const CyHairFile& f);

@@ -51,8 +51,8 @@ void TriMesh::check(const std::string& where) const {
   for (std::size_t f = 0; f < faces.size(); ++f)
     for (int k = 0; k < 3; ++k)
       if (faces[f][k] < 0 || faces[f][k] >= nv)
-        fail_at(where, "face {} references vertex {}, expected an index in [0, {})", f,
-                faces[f][k], nv);
+        fail_at(where, "face {} references vertex {}, expected an index in [0, {})", f, faces[f][k],
+                nv);
   if (uvs.empty() != uv_faces.empty())
     fail_at(where, "{} UVs but {} UV faces: both must be empty or neither", uvs.size(),
             uv_faces.size());
@@ -71,8 +71,8 @@ void TriMesh::check(const std::string& where) const {
   }
   if (!normals.empty()) {
     if (normals.size() != positions.size())
-      fail_at(where, "{} normals for {} vertices, expected one per vertex or none",
-              normals.size(), positions.size());
+      fail_at(where, "{} normals for {} vertices, expected one per vertex or none", normals.size(),
+              positions.size());
     for (std::size_t i = 0; i < normals.size(); ++i)
       if (!normals[i].allFinite()) fail_at(where, "normal {} is not finite", i);
   }

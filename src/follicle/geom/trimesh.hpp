@@ -11,11 +11,11 @@
 namespace follicle::geom {
 
 struct TriMesh {
-  std::vector<Vec3> positions;   // [m]
-  std::vector<Vec3i> faces;      // counter-clockwise seen from outside
-  std::vector<Vec2> uvs;         // texture coordinates, may be empty
-  std::vector<Vec3i> uv_faces;   // per-face UV indices; empty iff uvs is empty
-  std::vector<Vec3> normals;     // per position vertex, may be empty (compute_normals())
+  std::vector<Vec3> positions;  // [m]
+  std::vector<Vec3i> faces;     // counter-clockwise seen from outside
+  std::vector<Vec2> uvs;        // texture coordinates, may be empty
+  std::vector<Vec3i> uv_faces;  // per-face UV indices; empty iff uvs is empty
+  std::vector<Vec3> normals;    // per position vertex, may be empty (compute_normals())
   std::string name;
 
   std::size_t num_vertices() const { return positions.size(); }

@@ -565,7 +565,28 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     rep.message = "external force array size differs from the particle count";
     return rep;
   }
-  const double dt = in.dt / m_params.substeps;
+  // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
+  // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
+  int nsub = m_params.substeps;
+  if (m_params.cfl > 0) {
+    solve_alpha(ctx, s, ws);
+    const double w2 = deterministic_reduce(
+        ctx, n, 1024, 0.0,
+        [&](std::size_t i0, std::size_t i1) {
+          double w = 0;
+          for (std::size_t i = i0; i < i1; ++i) {
+            double ks = 0;
+            for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e)
+              ks += ws.alpha[m.adj_pairs[e]] * ws.k[m.adj_pairs[e]];
+            w = std::max(w, ks / m.mass[i]);
+          }
+          return w;
+        },
+        [](double a, double b) { return std::max(a, b); });
+    const double need = std::ceil(in.dt * std::sqrt(w2) / m_params.cfl);
+    if (std::isfinite(need)) nsub = std::max(nsub, int(std::min<double>(need, m_params.max_substeps)));
+  }
+  const double dt = in.dt / nsub;
   const anim::RigidSample& hd = in.head;
   const Mat3 R = hd.rotation, Rt = R.transpose();
   const Vec3 g_h = Rt * m_params.gravity;
@@ -576,7 +597,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.accel.resize(n);
   std::vector<uint8_t> contact(n, 0);
   std::vector<double> pen(n, 0.0);
-  for (int sub = 0; sub < m_params.substeps; ++sub) {
+  for (int sub = 0; sub < nsub; ++sub) {
     if (m_params.hair_hair) {
       neighbours_and_density(ctx, s, ws);
     } else {

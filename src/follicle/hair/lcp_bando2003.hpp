@@ -61,7 +61,9 @@ struct LcpInitParams {
 
 /// Dynamics (§3.3.2, §3.3.3, §3.5, §3.6).
 struct LcpParams {
-  int substeps = 4;                 // sub-steps per step() (fixed dt = step dt / substeps)
+  int substeps = 4;                 // minimum sub-steps per step()
+  double cfl = 0.5;                 // adaptive sub-steps: omega_max dt_sub <= cfl (0 = fixed)
+  int max_substeps = 2000;          // cap of the adaptive sub-step count
   Vec3 gravity{0, -9.81, 0};        // [m/s^2] world frame
   double air_drag = 0.6;            // [1/s] drag per unit mass against still air
   double elastic_modulus = 4000;    // E [Pa] of (3.10)/(3.11), kept constant per particle
@@ -80,7 +82,9 @@ struct LcpParams {
   double max_speed = 30;            // [m/s] a faster particle is reported as a blow-up
   template <class V>
   void visit(V&& v) {
-    v("substeps", substeps, ParamInfo{"sub-steps per step", "", 1, 10000});
+    v("substeps", substeps, ParamInfo{"minimum sub-steps per step", "", 1, 10000});
+    v("cfl", cfl, ParamInfo{"stability factor of the adaptive sub-step", "", 0, 2});
+    v("max_substeps", max_substeps, ParamInfo{"sub-step cap", "", 1, 1000000});
     v("gravity", gravity, ParamInfo{"gravity", "m/s^2", -1000, 1000});
     v("air_drag", air_drag, ParamInfo{"air drag per unit mass", "1/s", 0, 1e6});
     v("elastic_modulus", elastic_modulus, ParamInfo{"tensile modulus E", "Pa", 1e-6, 1e12});

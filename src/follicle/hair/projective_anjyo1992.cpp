@@ -165,28 +165,30 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
           const Vec3 dir0 = segment_direction(m_theta0[idx], m_phi0[idx]);
           a += (m_p.rest_spring / G) * (dir0 - dir);
         }
-        double sth = std::sin(th);
+        const double sth = std::sin(th);
+        double thn, phn;
         if (std::abs(sth) < m_p.parallel_threshold) {
-          // Segment nearly parallel to y: the θ plane is spanned by y and F (Fig. 8).
-          const Vec3 h(a.x(), 0.0, a.z());
-          const double hn = h.norm();
-          if (hn > 1e-12) {
-            const Vec3 hu = h / hn;
-            const double phn = std::atan2(hu.x(), hu.z());
-            const Vec3 dirp = segment_direction(thp, php);
-            th = std::atan2(dir.dot(hu), dir.y());
-            thp = std::atan2(dirp.dot(hu), dirp.y());
-            ph = php = nearest_branch(phn, ph);
-            sth = std::sin(th);
-          }
+          // Segment nearly parallel to y: the θ plane is spanned by y and F (Fig. 8), so the
+          // segment turns towards the horizontal part of F with θ'' = c u F_θ. Near the pole this
+          // is the small-angle form of (4)' for the horizontal offset h = (x, z) of the
+          // direction, written as a vector so the state does not jump when the plane follows F.
+          const Vec3 dirp = segment_direction(thp, php);
+          const Vec2 h(dir.x(), dir.z()), hp(dirp.x(), dirp.z()), ah(a.x(), a.z());
+          Vec2 hn = h + damp * (h - hp) + dt2 * G * ah;
+          if (hn.norm() > 1.0) hn.normalize();
+          const double yv = (dir.y() >= 0 ? 1.0 : -1.0) * std::sqrt(std::max(0.0, 1.0 - hn.squaredNorm()));
+          const Vec3 nd0(hn.x(), yv, hn.y());
+          direction_angles(nd0, ph, thn, phn);
+          direction_angles(dir, phn, th, ph);  // the current angles on the same branch
+        } else {
+          const double cth = std::cos(th), sph = std::sin(ph), cph = std::cos(ph);
+          const double Fth = a.x() * cth * sph - a.y() * sth + a.z() * cth * cph;  // (F, V_θ)
+          const double sgn = sth >= 0 ? 1.0 : -1.0;
+          const double Fph = sgn * (a.x() * cph - a.z() * sph);                   // (F, V_φ)
+          // (4)' and (5)': u_i = |s_i|/2, v_i = |s_i| |sin θ| / 2 -> v_i / u_i = |sin θ|.
+          thn = th + damp * (th - thp) + dt2 * G * Fth;
+          phn = ph + damp * (ph - php) + dt2 * G * std::abs(sth) * Fph;
         }
-        const double cth = std::cos(th), sph = std::sin(ph), cph = std::cos(ph);
-        const double Fth = a.x() * cth * sph - a.y() * sth + a.z() * cth * cph;  // (F, V_θ)
-        const double sgn = sth >= 0 ? 1.0 : -1.0;
-        const double Fph = sgn * (a.x() * cph - a.z() * sph);                   // (F, V_φ)
-        // (4)' and (5)': u_i = |s_i|/2, v_i = |s_i| |sin θ| / 2 -> v_i / u_i = |sin θ|.
-        double thn = th + damp * (th - thp) + dt2 * G * Fth;
-        double phn = ph + damp * (ph - php) + dt2 * G * std::abs(sth) * Fph;
         if (fluct) {
           Rng rng = Rng::stream(m_seed ^ (st.step * 0x9E3779B97F4A7C15ull), idx);
           thn += m_p.fluctuation * rng.uniform(-1.0, 1.0);

@@ -2,14 +2,14 @@
 // here) and EXR via OpenEXR. Every writer goes through write_atomically (temp file + rename).
 #include "follicle/image/image_io.hpp"
 
-#include <stb_image.h>
-#include <stb_image_write.h>
-
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <stb_image.h>
+#include <stb_image_write.h>
+
 #include <exception>
 #include <memory>
 #include <string>
@@ -29,9 +29,8 @@ Image<uint8_t, C> read_stb(const std::filesystem::path& path) {
   if (bytes.empty()) fail_at(path.string(), "empty file, expected a PNG or JPEG image");
   if (bytes.size() > std::size_t(INT32_MAX)) fail_at(path.string(), "file too large");
   int w = 0, h = 0, n = 0;
-  std::unique_ptr<unsigned char, StbFree> px(
-      stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w,
-                            &h, &n, C));
+  std::unique_ptr<unsigned char, StbFree> px(stbi_load_from_memory(
+      reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w, &h, &n, C));
   if (!px) {
     fail_at(path.string(), "cannot decode image ({}), expected a valid PNG or JPEG",
             stbi_failure_reason() ? stbi_failure_reason() : "unknown error");
@@ -124,11 +123,21 @@ Image<float, C> read_exr_impl(const std::filesystem::path& path,
 
 }  // namespace
 
-ImageRGBA8 read_png_rgba(const std::filesystem::path& path) { return read_stb<4>(path); }
-ImageGray8 read_png_gray(const std::filesystem::path& path) { return read_stb<1>(path); }
-void write_png(const std::filesystem::path& path, const ImageRGBA8& img) { write_stb_png(path, img); }
-void write_png(const std::filesystem::path& path, const ImageRGB8& img) { write_stb_png(path, img); }
-void write_png(const std::filesystem::path& path, const ImageGray8& img) { write_stb_png(path, img); }
+ImageRGBA8 read_png_rgba(const std::filesystem::path& path) {
+  return read_stb<4>(path);
+}
+ImageGray8 read_png_gray(const std::filesystem::path& path) {
+  return read_stb<1>(path);
+}
+void write_png(const std::filesystem::path& path, const ImageRGBA8& img) {
+  write_stb_png(path, img);
+}
+void write_png(const std::filesystem::path& path, const ImageRGB8& img) {
+  write_stb_png(path, img);
+}
+void write_png(const std::filesystem::path& path, const ImageGray8& img) {
+  write_stb_png(path, img);
+}
 
 ImageF read_exr_gray(const std::filesystem::path& path) {
   const float fill[1] = {0.f};

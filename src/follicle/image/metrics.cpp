@@ -43,8 +43,9 @@ ImageDiff compare_images(const Image<T, C>& a, const Image<T, C>& b, const DiffO
   return d;
 }
 
-#define FOLLICLE_INSTANTIATE(T, C) \
-  template ImageDiff compare_images<T, C>(const Image<T, C>&, const Image<T, C>&, const DiffOptions&);
+#define FOLLICLE_INSTANTIATE(T, C)                                                \
+  template ImageDiff compare_images<T, C>(const Image<T, C>&, const Image<T, C>&, \
+                                          const DiffOptions&);
 FOLLICLE_INSTANTIATE(uint8_t, 1)
 FOLLICLE_INSTANTIATE(uint8_t, 3)
 FOLLICLE_INSTANTIATE(uint8_t, 4)
@@ -53,7 +54,11 @@ FOLLICLE_INSTANTIATE(float, 3)
 FOLLICLE_INSTANTIATE(float, 4)
 #undef FOLLICLE_INSTANTIATE
 
-double rmse(const ImageRGBA8& a, const ImageRGBA8& b) { return compare_images(a, b).rmse; }
-double psnr(const ImageRGBA8& a, const ImageRGBA8& b) { return compare_images(a, b).psnr; }
+double rmse(const ImageRGBA8& a, const ImageRGBA8& b) {
+  return compare_images(a, b).rmse;
+}
+double psnr(const ImageRGBA8& a, const ImageRGBA8& b) {
+  return compare_images(a, b).psnr;
+}
 
 }  // namespace follicle::image

@@ -17,9 +17,9 @@ struct DiffOptions {
 };
 
 struct ImageDiff {
-  double rmse = 0.0;     // sqrt(mean over pixels and channels of (a-b)^2)
+  double rmse = 0.0;  // sqrt(mean over pixels and channels of (a-b)^2)
   double psnr = std::numeric_limits<double>::infinity();  // 20 log10(peak / rmse) [dB]
-  double max_abs = 0.0;  // largest |a-b| over pixels and channels
+  double max_abs = 0.0;                                   // largest |a-b| over pixels and channels
   double share_over = 0.0;  // share of pixels (0..1) with some channel |a-b| > threshold
   std::size_t pixels_over = 0;
 };

@@ -86,7 +86,8 @@ void draw_polyline(ImageF& img, const std::vector<Vec2>& pts, double width, floa
     for (int x = bx.x0; x <= bx.x1; ++x) {
       const Vec2 p(x + 0.5, y + 0.5);
       double d = 1e300;
-      for (std::size_t i = 0; i + 1 < pts.size(); ++i) d = std::min(d, seg_dist(p, pts[i], pts[i + 1]).d);
+      for (std::size_t i = 0; i + 1 < pts.size(); ++i)
+        d = std::min(d, seg_dist(p, pts[i], pts[i + 1]).d);
       const double cov = std::clamp(0.5 + r - d, 0.0, 1.0);
       if (cov > 0) blend_px(img.at(x, y), value, cov, blend);
     }
@@ -97,8 +98,9 @@ void draw_line_profile(ImageF& img, const Vec2& a, const Vec2& b, double radius,
                        const std::function<float(double d, double t)>& profile, Blend blend) {
   check_finite(a, radius, "draw_line_profile");
   check_finite(b, radius, "draw_line_profile");
-  const PixBox bx = box_of(img, std::min(a.x(), b.x()) - radius - 1, std::min(a.y(), b.y()) - radius - 1,
-                           std::max(a.x(), b.x()) + radius + 1, std::max(a.y(), b.y()) + radius + 1);
+  const PixBox bx =
+      box_of(img, std::min(a.x(), b.x()) - radius - 1, std::min(a.y(), b.y()) - radius - 1,
+             std::max(a.x(), b.x()) + radius + 1, std::max(a.y(), b.y()) + radius + 1);
   for (int y = bx.y0; y <= bx.y1; ++y) {
     for (int x = bx.x0; x <= bx.x1; ++x) {
       const SegDist sd = seg_dist(Vec2(x + 0.5, y + 0.5), a, b);

@@ -21,7 +21,8 @@ enum class Blend {
 };
 
 /// Filled disc of `radius` pixels.
-void draw_disc(ImageF& img, const Vec2& centre, double radius, float value, Blend blend = Blend::Over);
+void draw_disc(ImageF& img, const Vec2& centre, double radius, float value,
+               Blend blend = Blend::Over);
 /// Segment a-b with round caps, total width `width` pixels (a capsule of radius width/2).
 void draw_line(ImageF& img, const Vec2& a, const Vec2& b, double width, float value,
                Blend blend = Blend::Over);

@@ -26,7 +26,9 @@ Mat4 look_at(const Vec3& eye, const Vec3& target, const Vec3& up) {
   return m;
 }
 
-Mat4 view_matrix(const Camera& cam) { return look_at(cam.eye, cam.target, cam.up); }
+Mat4 view_matrix(const Camera& cam) {
+  return look_at(cam.eye, cam.target, cam.up);
+}
 
 Mat4 perspective(double fov_y, double aspect, double n, double f) {
   const double t = 1.0 / std::tan(0.5 * fov_y);
@@ -55,7 +57,8 @@ Mat4 orthographic(double l, double r, double b, double t, double n, double f) {
 }
 
 std::optional<Vec2> project_to_pixel(const Camera& cam, int width, int height, const Vec3& p) {
-  const Vec4 c = projection_matrix(cam, double(width) / height) * view_matrix(cam) * p.homogeneous();
+  const Vec4 c =
+      projection_matrix(cam, double(width) / height) * view_matrix(cam) * p.homogeneous();
   if (c.w() <= 0) return std::nullopt;
   const double x = c.x() / c.w(), y = c.y() / c.w();
   return Vec2((x * 0.5 + 0.5) * width, (0.5 - y * 0.5) * height);

@@ -12,7 +12,8 @@ Mat4 look_at(const Vec3& eye, const Vec3& target, const Vec3& up);
 Mat4 view_matrix(const Camera& cam);
 Mat4 perspective(double fov_y, double aspect, double z_near, double z_far);
 Mat4 projection_matrix(const Camera& cam, double aspect);
-Mat4 orthographic(double left, double right, double bottom, double top, double z_near, double z_far);
+Mat4 orthographic(double left, double right, double bottom, double top, double z_near,
+                  double z_far);
 
 /// Pixel coordinates (x right, y down; pixel (i, j) covers [i, i+1) x [j, j+1)) of world point p
 /// in a width x height image; nullopt when p is behind the camera.

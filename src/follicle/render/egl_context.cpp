@@ -65,7 +65,8 @@ std::unique_ptr<EglContext> EglContext::create() {
       reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
   auto query_device_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(
       eglGetProcAddress("eglQueryDeviceStringEXT"));
-  if (!get_display) fail("EGL: eglGetPlatformDisplayEXT is not available (no EGL_EXT_platform_base)");
+  if (!get_display)
+    fail("EGL: eglGetPlatformDisplayEXT is not available (no EGL_EXT_platform_base)");
 
   std::unique_ptr<EglContext> out(new EglContext());
   std::string why;
@@ -89,7 +90,9 @@ std::unique_ptr<EglContext> EglContext::create() {
       std::vector<EGLDeviceEXT> devs(static_cast<std::size_t>(n));
       query_devices(n, devs.data(), &n);
       for (EGLint i = 0; i < n; ++i) {
-        const char* exts = query_device_string ? query_device_string(devs[std::size_t(i)], EGL_EXTENSIONS) : nullptr;
+        const char* exts = query_device_string
+                               ? query_device_string(devs[std::size_t(i)], EGL_EXTENSIONS)
+                               : nullptr;
         if (has_ext(exts, "EGL_MESA_device_software")) {
           software.push_back(devs[std::size_t(i)]);
           continue;

@@ -15,7 +15,7 @@ class EglContext {
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;
 
-  void make_current() const;   // throws follicle::Error on failure
+  void make_current() const;                                  // throws follicle::Error on failure
   const std::string& platform() const { return m_platform; }  // e.g. "device (NVIDIA ...)"
 
  private:

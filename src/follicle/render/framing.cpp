@@ -25,24 +25,26 @@ Camera frame_box(const Eigen::AlignedBox3d& box, const Vec3& from_dir, double fo
 }
 
 RenderScene make_head_scene(const std::filesystem::path& head_dir, bool lafortune) {
-  auto mesh = std::make_shared<geom::TriMesh>(geom::load_mesh(head_dir / "head.obj", LengthUnit::mm));
+  auto mesh =
+      std::make_shared<geom::TriMesh>(geom::load_mesh(head_dir / "head.obj", LengthUnit::mm));
   RenderScene s;
   s.camera = frame_box(mesh->bounds(), Vec3(0.55, 0.12, 1.0), 0.5, 0.95);
   s.background = Vec3(0.05, 0.055, 0.065);
   s.ambient_color = Vec3(0.55, 0.6, 0.7);
   DirectionalLight key;
-  key.direction = Vec3(-0.6, -0.45, -0.9);
+  key.direction = Vec3(0.45, -0.6, -0.75);  // from the upper left of the camera
   key.color = Vec3(1.0, 0.96, 0.9);
   key.intensity = 1.1;
   DirectionalLight fill;
-  fill.direction = Vec3(0.8, -0.1, -0.5);
+  fill.direction = Vec3(-0.9, 0.0, -0.35);  // from the right
   fill.color = Vec3(0.55, 0.65, 0.9);
   fill.intensity = 0.3;
   fill.cast_shadow = false;
   s.lights = {key, fill};
   MeshItem m;
   m.mesh = mesh;
-  m.material.albedo_map = std::make_shared<image::ImageRGBA8>(image::read_png_rgba(head_dir / "albedo.jpg"));
+  m.material.albedo_map =
+      std::make_shared<image::ImageRGBA8>(image::read_png_rgba(head_dir / "albedo.jpg"));
   const image::ImageRGBA8 n8 = image::read_png_rgba(head_dir / "normal_tangent.jpg");
   auto nm = std::make_shared<image::ImageRGBF>(n8.width(), n8.height());
   for (int y = 0; y < n8.height(); ++y)

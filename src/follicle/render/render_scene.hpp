@@ -18,9 +18,9 @@ struct Camera {
   Vec3 eye{0, 0, 1};
   Vec3 target{0, 0, 0};
   Vec3 up{0, 1, 0};
-  double fov_y = 0.6;   // [rad] vertical field of view
-  double z_near = 0.01; // [m]
-  double z_far = 100.0; // [m]
+  double fov_y = 0.6;    // [rad] vertical field of view
+  double z_near = 0.01;  // [m]
+  double z_far = 100.0;  // [m]
 
   template <class V>
   void visit(V&& v) {
@@ -67,11 +67,11 @@ struct MeshMaterial {
   double specular = 0.15;
   double shininess = 32.0;
   double ambient = 0.15;
-  LafortuneBrdf lafortune;                    // for LafortuneSkin
+  LafortuneBrdf lafortune;                              // for LafortuneSkin
   std::shared_ptr<const image::ImageRGBA8> albedo_map;  // sRGB texture over the mesh UVs
   std::shared_ptr<const image::ImageF> height_map;      // bump map over the mesh UVs [m]
   double bump_strength = 1.0;
-  std::shared_ptr<const image::ImageRGBF> normal_map;   // tangent space, [-1,1]^3
+  std::shared_ptr<const image::ImageRGBF> normal_map;  // tangent space, [-1,1]^3
 };
 
 struct MeshItem {
@@ -106,8 +106,8 @@ struct StrandItem {
 };
 
 enum class ParticleShading {
-  Flat,         // colour (and opacity) of each particle as given
-  HairSplat,    // textured billboards aligned with the particle direction (Bando 2003 §3.4)
+  Flat,       // colour (and opacity) of each particle as given
+  HairSplat,  // textured billboards aligned with the particle direction (Bando 2003 §3.4)
 };
 
 struct ParticleItem {
@@ -132,7 +132,7 @@ struct RenderScene {
 struct RenderSettings {
   int width = 800;
   int height = 800;
-  int supersample = 2;   // render at (supersample * size) and box-filter down
+  int supersample = 2;  // render at (supersample * size) and box-filter down
   int shadow_map_size = 2048;
   bool transparent_background = false;  // background alpha 0 instead of 1 (output alpha = coverage)
 

@@ -5,12 +5,12 @@
 // item is one draw call.
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <numeric>
-#include <spdlog/spdlog.h>
 
 #include "follicle/render/camera.hpp"
 #include "follicle/render/egl_context.hpp"
@@ -65,7 +65,9 @@ GLuint link_program(const char* name, const std::string& defines, const char* vs
   return p;
 }
 
-Eigen::Matrix4f to_f(const Mat4& m) { return m.cast<float>(); }
+Eigen::Matrix4f to_f(const Mat4& m) {
+  return m.cast<float>();
+}
 
 void set_mat4(GLuint p, const char* n, const Mat4& m) {
   const Eigen::Matrix4f f = to_f(m);  // Eigen is column-major like GL
@@ -78,8 +80,12 @@ void set_mat3(GLuint p, const char* n, const Mat3& m) {
 void set_vec3(GLuint p, const char* n, const Vec3& v) {
   glUniform3f(glGetUniformLocation(p, n), float(v.x()), float(v.y()), float(v.z()));
 }
-void set_f(GLuint p, const char* n, double v) { glUniform1f(glGetUniformLocation(p, n), float(v)); }
-void set_i(GLuint p, const char* n, int v) { glUniform1i(glGetUniformLocation(p, n), v); }
+void set_f(GLuint p, const char* n, double v) {
+  glUniform1f(glGetUniformLocation(p, n), float(v));
+}
+void set_i(GLuint p, const char* n, int v) {
+  glUniform1i(glGetUniformLocation(p, n), v);
+}
 
 /// GL objects created for one render() and deleted at its end.
 struct FrameObjects {
@@ -143,9 +149,13 @@ struct ParticleDraw {
   bool blend = false;
 };
 
-double linear_scale(const Affine3& xf) { return std::cbrt(std::abs(xf.linear().determinant())); }
+double linear_scale(const Affine3& xf) {
+  return std::cbrt(std::abs(xf.linear().determinant()));
+}
 
-void extend(Eigen::AlignedBox3d& box, const Affine3& xf, const Vec3& p) { box.extend(xf * p); }
+void extend(Eigen::AlignedBox3d& box, const Affine3& xf, const Vec3& p) {
+  box.extend(xf * p);
+}
 
 /// Builds the unwelded per-corner vertex array of a mesh. Normals: the mesh's own, else
 /// area-weighted face normals. Pu, Pv (dP/du, dP/dv) are averaged per UV vertex so the tangent
@@ -256,9 +266,9 @@ class GlRenderer final : public Renderer {
   ~GlRenderer() override {
     try {
       if (m_egl) m_egl->make_current();
-      for (GLuint p : {m_mesh_prog, m_line_prog, m_ribbon_prog, m_depth_prog, m_particle_prog,
-                       m_resolve_prog})
+      for (GLuint p : {m_line_prog, m_ribbon_prog, m_depth_prog, m_particle_prog, m_resolve_prog})
         glDeleteProgram(p);
+      for (auto& [key, p] : m_mesh_progs) glDeleteProgram(p);
       for (auto& [k, t] : m_tex_cache) glDeleteTextures(1, &t.tex);
       release_targets();
       glDeleteVertexArrays(1, &m_empty_vao);
@@ -298,8 +308,8 @@ class GlRenderer final : public Renderer {
     draw(scene, settings);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, m_out_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target_fbo);
-    glBlitFramebuffer(0, 0, settings.width, settings.height, 0, 0, settings.width,
-                      settings.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBlitFramebuffer(0, 0, settings.width, settings.height, 0, 0, settings.width, settings.height,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_FRAMEBUFFER, target_fbo);
     check_gl("blit to target framebuffer");
   }
@@ -314,7 +324,7 @@ class GlRenderer final : public Renderer {
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
     if (major * 10 + minor < 33) fail("render: OpenGL 3.3 needed, got {}", m_description);
-    m_mesh_prog = link_program("mesh", "", glsl::kMeshVs, glsl::kMeshFs, nullptr, true);
+    (void)mesh_program(0);  // the plain Blinn-Phong variant; others compile on first use
     m_line_prog = link_program("strand-lines", "", glsl::kStrandVs, glsl::kStrandFs, nullptr, true);
     m_ribbon_prog = link_program("strand-ribbons", "#define RIBBONS\n", glsl::kStrandVs,
                                  glsl::kStrandFs, glsl::kStrandGs, true);
@@ -355,8 +365,8 @@ class GlRenderer final : public Renderer {
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
     const int lim = std::min(max_rb, max_tex);
     if (fw > lim || fh > lim)
-      fail("render: {}x{} at supersample {} needs a {}x{} framebuffer; this GL allows {}", w, h,
-           k, fw, fh, lim);
+      fail("render: {}x{} at supersample {} needs a {}x{} framebuffer; this GL allows {}", w, h, k,
+           fw, fh, lim);
     if (shadow_size > max_tex)
       fail("render: shadow_map_size {} exceeds GL_MAX_TEXTURE_SIZE {}", shadow_size, max_tex);
     if (fw != m_fb_w || fh != m_fb_h || w != m_out_w || h != m_out_h) {
@@ -422,8 +432,8 @@ class GlRenderer final : public Renderer {
   /// Textures are cached by image identity (shared_ptr<const Image> means the pixels are
   /// immutable); an entry is dropped when its image has been destroyed.
   template <class Img>
-  GLuint texture(const std::shared_ptr<const Img>& img, GLenum internal, GLenum format,
-                 GLenum type, bool mipmap) {
+  GLuint texture(const std::shared_ptr<const Img>& img, GLenum internal, GLenum format, GLenum type,
+                 bool mipmap) {
     auto it = m_tex_cache.find(img.get());
     if (it != m_tex_cache.end() && !it->second.owner.expired() &&
         it->second.owner.lock().get() == static_cast<const void*>(img.get())) {
@@ -592,22 +602,15 @@ class GlRenderer final : public Renderer {
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
     if (!meshes.empty()) {
-      const GLuint p = m_mesh_prog;
-      glUseProgram(p);
-      set_mat4(p, "uViewProj", view_proj);
-      set_lights(p, scene);
-      set_i(p, "uAlbedoTex", 0);
-      set_i(p, "uHeightTex", 1);
-      set_i(p, "uNormalTex", 2);
-      set_i(p, "uShadowTex", 3);
-      glActiveTexture(GL_TEXTURE3);
-      glBindTexture(GL_TEXTURE_2D, m_shadow_tex);
-      set_i(p, "uShadowLight", shadows ? shadow_light : -1);
-      set_mat4(p, "uLightVP", light_vp);
-      set_f(p, "uShadowTexel", 1.0 / settings.shadow_map_size);
-      set_f(p, "uShadowNormalOffset", 1.5 * shadow_texel_world);
-      set_f(p, "uShadowBias", 1.0 * shadow_texel_world / shadow_depth_range);
-      for (const MeshDraw& d : meshes) draw_mesh(p, d);
+      MeshPassState st;
+      st.scene = &scene;
+      st.view_proj = view_proj;
+      st.shadow_light = shadows ? shadow_light : -1;
+      st.light_vp = light_vp;
+      st.shadow_texel = 1.0 / settings.shadow_map_size;
+      st.shadow_normal_offset = 1.5 * shadow_texel_world;
+      st.shadow_bias = 1.0 * shadow_texel_world / shadow_depth_range;
+      for (const MeshDraw& d : meshes) draw_mesh(st, d);
       check_gl("mesh pass");
     }
     if (!strands.empty()) draw_strands(scene, settings, strands, view_proj, proj);
@@ -651,21 +654,67 @@ class GlRenderer final : public Renderer {
     check_gl("resolve");
   }
 
-  void draw_mesh(GLuint p, const MeshDraw& d) {
+  struct MeshPassState {
+    const RenderScene* scene = nullptr;
+    Mat4 view_proj, light_vp;
+    int shadow_light = -1;
+    double shadow_texel = 0, shadow_normal_offset = 0, shadow_bias = 0;
+  };
+
+  enum MeshFeature { kAlbedo = 4, kHeight = 8, kNormalMap = 16, kShadow = 32 };
+
+  /// Mesh program variant: bits 0-1 shading (0 Blinn-Phong, 1 Lafortune, 2 unlit), then
+  /// MeshFeature bits. Compiled on first use and kept.
+  GLuint mesh_program(int key) {
+    auto it = m_mesh_progs.find(key);
+    if (it != m_mesh_progs.end()) return it->second;
+    std::string defs = fmt::format("#define SHADING {}\n", key & 3);
+    if (key & kAlbedo) defs += "#define HAS_ALBEDO\n";
+    if (key & kHeight) defs += "#define HAS_HEIGHT\n";
+    if (key & kNormalMap) defs += "#define HAS_NORMALMAP\n";
+    if (key & kShadow) defs += "#define HAS_SHADOW\n";
+    const GLuint p = link_program("mesh", defs, glsl::kMeshVs, glsl::kMeshFs, nullptr, true);
+    m_mesh_progs[key] = p;
+    return p;
+  }
+
+  void draw_mesh(const MeshPassState& st, const MeshDraw& d) {
     const MeshItem& item = *d.item;
     const MeshMaterial& mat = item.material;
-    set_mat4(p, "uModel", item.transform.matrix());
-    set_mat3(p, "uNormalMat", item.transform.linear().inverse().transpose());
     const int shading = mat.shading == MeshShading::BlinnPhong      ? 0
                         : mat.shading == MeshShading::LafortuneSkin ? 1
                                                                     : 2;
-    set_i(p, "uShading", shading);
-    set_vec3(p, "uBaseColor", shading == 1 ? mat.lafortune.rho_d : mat.base_color);
+    const bool albedo = mat.albedo_map && d.has_uvs;
+    const bool height = mat.height_map && d.has_uvs && shading != 2;
+    const bool nmap = mat.normal_map && d.has_uvs && shading != 2;
+    const bool shadow = st.shadow_light >= 0 && shading != 2;
+    const int key = shading | (albedo ? kAlbedo : 0) | (height ? kHeight : 0) |
+                    (nmap ? kNormalMap : 0) | (shadow ? kShadow : 0);
+    const GLuint p = mesh_program(key);
+    glUseProgram(p);
+    set_mat4(p, "uViewProj", st.view_proj);
+    set_lights(p, *st.scene);
+    set_mat4(p, "uModel", item.transform.matrix());
+    set_mat3(p, "uNormalMat", item.transform.linear().inverse().transpose());
+    if (shadow) {
+      set_i(p, "uShadowTex", 3);
+      glActiveTexture(GL_TEXTURE3);
+      glBindTexture(GL_TEXTURE_2D, m_shadow_tex);
+      set_i(p, "uShadowLight", st.shadow_light);
+      set_mat4(p, "uLightVP", st.light_vp);
+      set_f(p, "uShadowTexel", st.shadow_texel);
+      set_f(p, "uShadowNormalOffset", st.shadow_normal_offset);
+      set_f(p, "uShadowBias", st.shadow_bias);
+    }
+    // Albedo: per-vertex colours, else the base colour (rho_d for Lafortune), times the
+    // texture when there is one (the texture alone when there are no vertex colours).
+    const Vec3 base =
+        albedo ? Vec3(1, 1, 1) : (shading == 1 ? mat.lafortune.rho_d : mat.base_color);
+    set_vec3(p, "uBaseColor", base);
     set_i(p, "uUseVertexColor", item.vertex_colors.empty() ? 0 : 1);
     set_f(p, "uSpecular", mat.specular);
     set_f(p, "uShininess", mat.shininess);
     set_f(p, "uAmbient", mat.ambient);
-    set_vec3(p, "uRhoD", mat.lafortune.rho_d);
     if (mat.lafortune.lobes.size() > std::size_t(kMaxLobes))
       fail("render: at most {} Lafortune lobes are supported", kMaxLobes);
     set_i(p, "uNumLobes", int(mat.lafortune.lobes.size()));
@@ -674,18 +723,14 @@ class GlRenderer final : public Renderer {
       set_vec3(p, fmt::format("uCz[{}]", l).c_str(), mat.lafortune.lobes[l].cz);
       set_vec3(p, fmt::format("uN[{}]", l).c_str(), mat.lafortune.lobes[l].n);
     }
-    const bool albedo = mat.albedo_map && d.has_uvs;
-    const bool height = mat.height_map && d.has_uvs && shading != 2;
-    const bool nmap = mat.normal_map && d.has_uvs && shading != 2;
-    set_i(p, "uUseAlbedo", albedo ? 1 : 0);
-    set_i(p, "uUseHeight", height ? 1 : 0);
-    set_i(p, "uUseNormalMap", nmap ? 1 : 0);
     if (albedo) {
+      set_i(p, "uAlbedoTex", 0);
       glActiveTexture(GL_TEXTURE0);
-      glBindTexture(GL_TEXTURE_2D, texture(mat.albedo_map, GL_SRGB8_ALPHA8, GL_RGBA,
-                                           GL_UNSIGNED_BYTE, true));
+      glBindTexture(GL_TEXTURE_2D,
+                    texture(mat.albedo_map, GL_SRGB8_ALPHA8, GL_RGBA, GL_UNSIGNED_BYTE, true));
     }
     if (height) {
+      set_i(p, "uHeightTex", 1);
       glActiveTexture(GL_TEXTURE1);
       glBindTexture(GL_TEXTURE_2D, texture(mat.height_map, GL_R32F, GL_RED, GL_FLOAT, false));
       glUniform2f(glGetUniformLocation(p, "uHeightTexel"), 1.0f / mat.height_map->width(),
@@ -693,6 +738,7 @@ class GlRenderer final : public Renderer {
       set_f(p, "uBumpStrength", mat.bump_strength);
     }
     if (nmap) {
+      set_i(p, "uNormalTex", 2);
       glActiveTexture(GL_TEXTURE2);
       glBindTexture(GL_TEXTURE_2D, texture(mat.normal_map, GL_RGB16F, GL_RGB, GL_FLOAT, true));
     }
@@ -856,8 +902,9 @@ class GlRenderer final : public Renderer {
   std::shared_ptr<spdlog::logger> m_log;
   std::unique_ptr<EglContext> m_egl;
   std::string m_description;
-  GLuint m_mesh_prog = 0, m_line_prog = 0, m_ribbon_prog = 0, m_depth_prog = 0,
-         m_particle_prog = 0, m_resolve_prog = 0;
+  std::map<int, GLuint> m_mesh_progs;
+  GLuint m_line_prog = 0, m_ribbon_prog = 0, m_depth_prog = 0, m_particle_prog = 0,
+         m_resolve_prog = 0;
   GLuint m_empty_vao = 0, m_quad_vbo = 0;
   GLuint m_fbo = 0, m_color_tex = 0, m_depth_rb = 0, m_out_fbo = 0, m_out_rb = 0;
   GLuint m_shadow_fbo = 0, m_shadow_tex = 0;

@@ -41,6 +41,9 @@ void main() {
 }
 )";
 
+// Features are compile-time (#define SHADING 0|1|2, HAS_ALBEDO, HAS_HEIGHT, HAS_NORMALMAP,
+// HAS_SHADOW): llvmpipe runs both sides of data-dependent branches, so texture fetches behind
+// a run-time flag would cost as much as taken ones.
 inline constexpr const char* kMeshFs = R"(
 in vec3 vPos;
 in vec3 vNormal;
@@ -49,32 +52,28 @@ in vec3 vColor;
 in vec3 vPu;
 in vec3 vPv;
 out vec4 fragColor;
-uniform int uShading;  // 0 Blinn-Phong, 1 Lafortune skin, 2 unlit
 uniform vec3 uBaseColor;
 uniform bool uUseVertexColor;
-uniform bool uUseAlbedo;
 uniform sampler2D uAlbedoTex;
-uniform bool uUseHeight;
 uniform sampler2D uHeightTex;
 uniform vec2 uHeightTexel;
 uniform float uBumpStrength;
-uniform bool uUseNormalMap;
 uniform sampler2D uNormalTex;
 uniform float uSpecular;
 uniform float uShininess;
 uniform float uAmbient;
-uniform int uShadowLight;  // index of the shadowing light or -1
+uniform int uShadowLight;  // index of the shadowing light
 uniform sampler2DShadow uShadowTex;
 uniform mat4 uLightVP;
 uniform float uShadowTexel;       // 1 / shadow map size
 uniform float uShadowNormalOffset; // [m]
 uniform float uShadowBias;        // in depth-buffer units
-uniform vec3 uRhoD;
 uniform int uNumLobes;
 uniform vec3 uCxy[4];
 uniform vec3 uCz[4];
 uniform vec3 uN[4];
 
+#ifdef HAS_SHADOW
 float shadow_factor(vec3 p, vec3 ng) {
   vec4 c = uLightVP * vec4(p + ng * uShadowNormalOffset, 1.0);
   vec3 s = c.xyz / c.w * 0.5 + 0.5;
@@ -86,6 +85,7 @@ float shadow_factor(vec3 p, vec3 ng) {
       sum += texture(uShadowTex, vec3(s.xy + (vec2(i, j) - 0.5) * uShadowTexel, s.z - uShadowBias));
   return 0.25 * sum;
 }
+#endif
 
 // docs/skin-constants.md §4.1: f = rho_d/pi + sum_k max(0, Cxy (wo.x wi.x + wo.y wi.y) + Cz wo.z wi.z)^n
 vec3 lafortune(vec3 albedo, vec3 n, vec3 wo, vec3 wi) {
@@ -101,44 +101,55 @@ void main() {
   if (!gl_FrontFacing) ng = -ng;
   vec3 N = ng;
   vec2 tc = vec2(vUV.x, 1.0 - vUV.y);  // image row 0 is the top (v = 1)
-  float orient = sign(dot(cross(vPu, vPv), ng));
-  float area = length(cross(vPu, vPv));
-  if (uUseHeight && area > 1e-20) {
-    // Blinn 1978 bump mapping: N' = N + (Fu (N x Pv) - Fv (N x Pu)) / |Pu x Pv|
-    float fu = (texture(uHeightTex, tc + vec2(uHeightTexel.x, 0.0)).r -
-                texture(uHeightTex, tc - vec2(uHeightTexel.x, 0.0)).r) / (2.0 * uHeightTexel.x);
-    float fv = -(texture(uHeightTex, tc + vec2(0.0, uHeightTexel.y)).r -
-                 texture(uHeightTex, tc - vec2(0.0, uHeightTexel.y)).r) / (2.0 * uHeightTexel.y);
-    N = normalize(N + uBumpStrength * orient * (fu * cross(N, vPv) - fv * cross(N, vPu)) / area);
-  }
-  if (uUseNormalMap && area > 1e-20) {
-    vec3 t = texture(uNormalTex, tc).xyz;
-    vec3 T = normalize(vPu - N * dot(N, vPu));
-    vec3 B = cross(N, T) * orient;
-    N = normalize(t.x * T + t.y * B + t.z * N);
-  }
-  vec3 albedo = uUseVertexColor ? vColor : (uUseAlbedo ? vec3(1.0) : uBaseColor);
-  if (uUseAlbedo) albedo *= texture(uAlbedoTex, tc).rgb;
-  if (uShading == 2) {
-    fragColor = vec4(albedo, 1.0);
-    return;
-  }
+#if defined(HAS_HEIGHT) || defined(HAS_NORMALMAP)
+  vec3 puv = cross(vPu, vPv);
+  float orient = dot(puv, ng) < 0.0 ? -1.0 : 1.0;
+  float area = max(length(puv), 1e-20);
+#endif
+#ifdef HAS_HEIGHT
+  // Blinn 1978 bump mapping: N' = N + (Fu (N x Pv) - Fv (N x Pu)) / |Pu x Pv|
+  float fu = (texture(uHeightTex, tc + vec2(uHeightTexel.x, 0.0)).r -
+              texture(uHeightTex, tc - vec2(uHeightTexel.x, 0.0)).r) / (2.0 * uHeightTexel.x);
+  float fv = -(texture(uHeightTex, tc + vec2(0.0, uHeightTexel.y)).r -
+               texture(uHeightTex, tc - vec2(0.0, uHeightTexel.y)).r) / (2.0 * uHeightTexel.y);
+  N = normalize(N + uBumpStrength * orient * (fu * cross(N, vPv) - fv * cross(N, vPu)) / area);
+#endif
+#ifdef HAS_NORMALMAP
+  vec3 t = texture(uNormalTex, tc).xyz;
+  vec3 T = vPu - N * dot(N, vPu);
+  T = dot(T, T) > 1e-30 ? normalize(T) : normalize(cross(N, abs(N.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0)));
+  vec3 B = cross(N, T) * orient;
+  N = normalize(t.x * T + t.y * B + t.z * N);
+#endif
+  vec3 albedo = uUseVertexColor ? vColor : uBaseColor;
+#ifdef HAS_ALBEDO
+  albedo *= texture(uAlbedoTex, tc).rgb;
+#endif
+#if SHADING == 2
+  fragColor = vec4(albedo, 1.0);
+#else
   vec3 V = normalize(uEye - vPos);
   vec3 col = albedo * uAmbient * uAmbientColor;
+#ifdef HAS_SHADOW
+  float shadow = shadow_factor(vPos, ng);
+#endif
   for (int i = 0; i < uNumLights; ++i) {
     vec3 L = uLightDir[i];
-    float ndl = dot(N, L);
-    if (ndl <= 0.0) continue;
-    float sh = (i == uShadowLight) ? shadow_factor(vPos, ng) : 1.0;
-    if (uShading == 1) {
-      col += 3.14159265 * lafortune(albedo, N, V, L) * ndl * uLightColor[i] * sh;
-    } else {
-      vec3 H = normalize(L + V);
-      float spec = uSpecular * pow(max(dot(N, H), 0.0), uShininess);
-      col += (albedo * ndl + vec3(spec)) * uLightColor[i] * sh;
-    }
+    float ndl = max(dot(N, L), 0.0);
+    vec3 E = uLightColor[i];
+#ifdef HAS_SHADOW
+    if (i == uShadowLight) E *= shadow;
+#endif
+#if SHADING == 1
+    col += 3.14159265 * lafortune(albedo, N, V, L) * ndl * E;
+#else
+    vec3 H = normalize(L + V);
+    float spec = ndl > 0.0 ? uSpecular * pow(max(dot(N, H), 0.0), uShininess) : 0.0;
+    col += (albedo * ndl + vec3(spec)) * E;
+#endif
   }
   fragColor = vec4(col, 1.0);
+#endif
 }
 )";
 

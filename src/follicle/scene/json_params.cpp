@@ -100,9 +100,21 @@ void json_fail(const JsonSource& src, const std::string& path, const std::string
   throw Error(where(src, path), what);
 }
 
+std::string suggest(const std::string& key, const std::vector<std::string>& known) {
+  // A truncated or extended name ("fov" for "fov_deg") is the likeliest mistake, even when the
+  // plain edit distance prefers another key ("far"); then fall back to the edit distance.
+  std::string best;
+  for (const auto& k : known) {
+    const bool prefix = (key.size() >= 2 && k.rfind(key, 0) == 0) ||
+                        (k.size() >= 3 && key.rfind(k, 0) == 0);
+    if (prefix && (best.empty() || edit_distance(key, k) < edit_distance(key, best))) best = k;
+  }
+  return best.empty() ? did_you_mean(key, known) : best;
+}
+
 void json_fail_unknown_key(const JsonSource& src, const std::string& path, const std::string& key,
                            const std::vector<std::string>& known) {
-  const std::string hint = did_you_mean(key, known);
+  const std::string hint = suggest(key, known);
   json_fail(src, join_path(path, key),
             "unknown key \"" + key + "\"" +
                 (hint.empty() ? std::string() : " (did you mean \"" + hint + "\"?)") +
@@ -133,9 +145,10 @@ void check_number_range(const JsonSource& src, const std::string& path, double v
   if (!std::isfinite(v)) json_fail(src, path, fmt::format("value {} is not a finite number", v));
   if (v < info.min || v > info.max) {
     json_fail(src, path,
-              fmt::format("value {} is out of range: expected {}{}in [{}, {}]{}", v, info.doc,
-                          *info.doc ? " " : "", format_bound(info.min), format_bound(info.max),
-                          *info.unit ? std::string(" ") + info.unit : std::string()));
+              fmt::format("value {} is out of range [{}, {}]{}{}", v, format_bound(info.min),
+                          format_bound(info.max),
+                          *info.unit ? std::string(" ") + info.unit : std::string(),
+                          *info.doc ? fmt::format(" ({})", info.doc) : std::string()));
   }
 }
 

@@ -62,6 +62,8 @@ std::string join_path(const std::string& path, const std::string& key);
 std::string index_path(const std::string& path, std::size_t i);
 /// Throws follicle::Error("<file>: <path>", what).
 [[noreturn]] void json_fail(const JsonSource& src, const std::string& path, const std::string& what);
+/// The most plausible intended name for a mistyped `key` ("" when nothing is close).
+std::string suggest(const std::string& key, const std::vector<std::string>& known);
 /// Throws the unknown-key error with a did-you-mean and the list of accepted keys.
 [[noreturn]] void json_fail_unknown_key(const JsonSource& src, const std::string& path,
                                         const std::string& key,
@@ -192,7 +194,7 @@ void read_json(const Json& j, const std::string& path, T& out, const JsonSource&
         return;
       }
     }
-    const std::string hint = did_you_mean(s, names);
+    const std::string hint = suggest(s, names);
     json_fail(src, path,
               "unknown value \"" + s + "\"" + (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
                   "; expected one of " + quoted_list(names));

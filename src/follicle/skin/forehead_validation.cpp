@@ -14,8 +14,12 @@ geom::TriMesh make_cylinder_patch(double width, double height, double radius, do
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i) {
       const double s = -0.5 * width + width * i / nx, y = -0.5 * height + height * j / ny;
-      const double th = s / radius;
-      m.positions.emplace_back(radius * std::sin(th), y, radius * std::cos(th));
+      if (radius > 0) {
+        const double th = s / radius;
+        m.positions.emplace_back(radius * std::sin(th), y, radius * std::cos(th));
+      } else {
+        m.positions.emplace_back(s, y, 0.0);  // flat patch
+      }
       m.uvs.emplace_back((s + 0.5 * width) / size, (y + 0.5 * height) / size);
     }
   auto id = [&](int i, int j) { return j * (nx + 1) + i; };

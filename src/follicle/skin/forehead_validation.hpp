@@ -54,7 +54,8 @@ struct ForeheadCase {
   double max_shrinkage_error = 0;  // max |s - s0|
 };
 
-/// A cylindrical patch grid with isometric UVs (u = arc/size, v = y/size, size = max(w, h)).
+/// A cylindrical patch grid with isometric UVs (u = arc/size, v = y/size, size = max(w, h));
+/// radius <= 0 gives a flat patch in the z = 0 plane.
 geom::TriMesh make_cylinder_patch(double width, double height, double radius, double spacing);
 
 ForeheadCase make_forehead_case(const Context& ctx, const ForeheadCaseParams& p);

@@ -94,8 +94,10 @@ double texture_scale(const geom::TriMesh& mesh, const TextureSpaceMesh& tex, con
   return auv > 0 ? std::sqrt(a3 / auv) : 1.0;
 }
 
-WrinkleLayer::WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> wrinkles, double cutoff_widths)
-    : m_rest(rest), m_tex(TextureSpaceMesh::build(rest)), m_wrinkles(std::move(wrinkles)), m_cutoff(cutoff_widths) {
+WrinkleLayer::WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> wrinkles, double cutoff_widths,
+                           ShrinkageMethod method)
+    : m_rest(rest), m_tex(TextureSpaceMesh::build(rest)), m_wrinkles(std::move(wrinkles)), m_cutoff(cutoff_widths),
+      m_method(method) {
   std::vector<int> all(rest.faces.size());
   for (std::size_t f = 0; f < all.size(); ++f) all[f] = int(f);
   m_global_scale = texture_scale(m_rest, m_tex, all);
@@ -187,7 +189,10 @@ void WrinkleLayer::build(std::size_t i) {
         s.b = std::max(ab.y(), 0.0);
         s.rest2 = (m_rest.positions[std::size_t(s.j2)] - m_rest.positions[v]).norm();
         s.rest3 = (m_rest.positions[std::size_t(s.j3)] - m_rest.positions[v]).norm();
-        if (s.rest2 <= 0 || s.rest3 <= 0 || s.a + s.b <= 0) continue;
+        s.rest_span = (s.a * (m_rest.positions[std::size_t(s.j2)] - m_rest.positions[v]) +
+                       s.b * (m_rest.positions[std::size_t(s.j3)] - m_rest.positions[v]))
+                          .norm();
+        if (s.rest2 <= 0 || s.rest3 <= 0 || s.a + s.b <= 0 || s.rest_span <= 0) continue;
         e.side[std::size_t(e.nsides++)] = s;
         break;
       }
@@ -207,9 +212,12 @@ void WrinkleLayer::shrinkage(const Context& ctx, std::size_t i, const std::vecto
     const Vec3& p1 = p[std::size_t(e.vertex)];
     for (int j = 0; j < e.nsides; ++j) {
       const auto& sd = e.side[std::size_t(j)];
-      const double t2 = (p[std::size_t(sd.j2)] - p1).norm() / sd.rest2;
-      const double t3 = (p[std::size_t(sd.j3)] - p1).norm() / sd.rest3;
-      acc += triangle_shrinkage(sd.a, sd.b, t2, t3);  // (2.3)
+      const Vec3 x2 = p[std::size_t(sd.j2)] - p1, x3 = p[std::size_t(sd.j3)] - p1;
+      if (m_method == ShrinkageMethod::edge_scaling) {
+        acc += triangle_shrinkage(sd.a, sd.b, x2.norm() / sd.rest2, x3.norm() / sd.rest3);  // (2.3)
+      } else {
+        acc += 1.0 - (sd.a * x2 + sd.b * x3).norm() / sd.rest_span;  // (2.3) s = 1 - L'/L
+      }
     }
     s[k] = e.nsides > 0 ? acc / e.nsides : 0.0;  // average of the +d_p and -d_p triangles
   }, 512);

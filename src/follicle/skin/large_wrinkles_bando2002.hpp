@@ -55,6 +55,7 @@ struct WrinkleInfluence {
     int j2 = -1, j3 = -1;     // the other two vertices of the triangle in direction +-d_p
     double a = 0, b = 0;      // d_p = a e2 + b e3 in texture space
     double rest2 = 0, rest3 = 0;  // rest 3D lengths of edges v1v2, v1v3
+    double rest_span = 0;         // |a X2 + b X3| in the rest 3D triangle
   };
   struct Entry {
     int vertex = -1;
@@ -67,11 +68,23 @@ struct WrinkleInfluence {
   double texture_scale = 0;  // metres per texture unit around this wrinkle
 };
 
+/// How L' in (2.3) is measured for the triangle in direction d_p.
+enum class ShrinkageMethod {
+  /// Paper's construction: edges v1v2, v1v3 scaled by their 3D length ratios t2, t3 inside the
+  /// texture space, L' where the ray d_p meets the scaled edge (exact only when the two edges
+  /// scale alike; underestimates uniaxial shrinkage on refined/irregular triangulations).
+  edge_scaling,
+  /// Same L'/L taken from the triangle's affine deformation: the segment a e2 + b e3 along d_p
+  /// maps to a X2 + b X3 in 3D, rest and current; exact for any triangulation and identical to
+  /// edge_scaling when both edges scale alike. Default.
+  deformation,
+};
+
 /// The wrinkle layer over a (refined) rest mesh.
 class WrinkleLayer {
  public:
   WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> wrinkles,
-               double cutoff_widths = 10.0);
+               double cutoff_widths = 10.0, ShrinkageMethod method = ShrinkageMethod::deformation);
   std::size_t num_wrinkles() const { return m_wrinkles.size(); }
   const LargeWrinkle& wrinkle(std::size_t i) const { return m_wrinkles[i]; }
   const std::vector<LargeWrinkle>& wrinkles() const { return m_wrinkles; }
@@ -97,6 +110,7 @@ class WrinkleLayer {
   std::vector<LargeWrinkle> m_wrinkles;
   std::vector<WrinkleInfluence> m_infl;
   double m_cutoff;
+  ShrinkageMethod m_method;
   double m_global_scale = 1;
 };
 

@@ -13,7 +13,7 @@ using namespace follicle::skin;
 namespace {
 // Flat 60 x 60 mm patch, 1.5 mm grid, horizontal furrow through the middle.
 struct Patch {
-  geom::TriMesh mesh = make_cylinder_patch(0.06, 0.06, 1e4, 0.0015);
+  geom::TriMesh mesh = make_cylinder_patch(0.06, 0.06, 0.0, 0.0015);
   LargeWrinkle w;
   Patch() {
     w.control = {Vec2(0.1, 0.5), Vec2(0.4, 0.5), Vec2(0.6, 0.5), Vec2(0.9, 0.5)};
@@ -44,7 +44,7 @@ TEST(Shrinkage, RigidMotionGivesZeroShrinkageAndUnchangedWrinkles) {
   layer.heights(ctx, moved, h);
   layer.rest_heights(h0);
   ASSERT_EQ(h.size(), h0.size());
-  for (std::size_t i = 0; i < h.size(); ++i) EXPECT_NEAR(h[i], h0[i], 1e-15);
+  for (std::size_t i = 0; i < h.size(); ++i) EXPECT_NEAR(h[i], h0[i], 1e-12);
 }
 
 TEST(Shrinkage, AlongFurrowKeepsAmplitudeAcrossRaisesIt) {
@@ -65,7 +65,7 @@ TEST(Shrinkage, AlongFurrowKeepsAmplitudeAcrossRaisesIt) {
   const double a0 = max_abs(h0), a1 = max_abs(h_along), a2 = max_abs(h_across);
   EXPECT_NEAR(a1, a0, 1e-12);
   EXPECT_NEAR(a2 / a0, amplitude_modulation(0.3, 0.4) / amplitude_modulation(0.0, 0.4), 1e-9);
-  EXPECT_GT(a2, 1.5 * a0);
+  EXPECT_GT(a2, 1.4 * a0);
 }
 
 TEST(Shrinkage, ExpansionLowersAmplitudeAndRZeroHidesWrinkles) {
@@ -96,3 +96,20 @@ TEST(Shrinkage, OnlyAffectedVerticesRecomputedOnEdit) {
   EXPECT_DOUBLE_EQ(layer.wrinkle(0).depth, 0.001);
 }
 
+
+TEST(Shrinkage, PaperEdgeScalingAgreesWhenEdgesScaleAlike) {
+  Context ctx(1);
+  Patch p;
+  WrinkleLayer paper(p.mesh, {p.w}, 10.0, ShrinkageMethod::edge_scaling);
+  WrinkleLayer exact(p.mesh, {p.w}, 10.0, ShrinkageMethod::deformation);
+  std::vector<Vec3> iso = p.mesh.positions;
+  for (auto& q : iso) q = Vec3(0.8 * q.x(), 0.8 * q.y(), q.z());  // uniform in-plane shrink
+  std::vector<double> a, b;
+  paper.shrinkage(ctx, 0, iso, a);
+  exact.shrinkage(ctx, 0, iso, b);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(a[i], 0.2, 1e-9);
+    EXPECT_NEAR(b[i], 0.2, 1e-9);
+  }
+}

@@ -1,4 +1,6 @@
 // Mesh I/O: round trips in every format, units, the shipped head, malformed inputs.
+#include "follicle/geom/mesh_io.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -7,7 +9,6 @@
 #include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/rng.hpp"
-#include "follicle/geom/mesh_io.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
@@ -93,7 +94,7 @@ TEST_P(PlyRoundTrip, PositionsUvsNormalsSurvive) {
   EXPECT_NE(head.find(ascii ? "format ascii" : "format binary_little_endian"), std::string::npos);
   const TriMesh back = load_mesh(dir / "c.ply", LengthUnit::cm);
   expect_same_surface(cube, back, 1e-12);
-  EXPECT_EQ(back.uv_faces, back.faces);  // per-vertex UVs
+  EXPECT_EQ(back.uv_faces, back.faces);                 // per-vertex UVs
   EXPECT_GT(back.num_vertices(), cube.num_vertices());  // split at UV seams
   ASSERT_TRUE(back.has_normals());
 }

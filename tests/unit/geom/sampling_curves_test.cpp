@@ -28,7 +28,8 @@ TriMesh make_grid(int n, double size = 1.0) {
 TEST(Sampling, UniformByAreaOnTwoTriangles) {
   // Triangle 0 has area 0.5, triangle 1 area 1.5 (3x): expect 25% / 75% of the samples.
   TriMesh m;
-  m.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(5, 0, 0), Vec3(8, 0, 0), Vec3(5, 1, 0)};
+  m.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0),
+                 Vec3(5, 0, 0), Vec3(8, 0, 0), Vec3(5, 1, 0)};
   m.faces = {Vec3i(0, 1, 2), Vec3i(3, 4, 5)};
   Context ctx(2);
   const std::size_t n = 40000;
@@ -48,8 +49,9 @@ TEST(Sampling, UniformByAreaOnTwoTriangles) {
                       (double(n - c0) - e1) * (double(n - c0) - e1) / e1;
   EXPECT_LT(chi2, 10.83);
   // Inside a face the density is uniform too: a quarter of triangle 0 lies below x + y = 0.5.
-  const double es = 0.25 * double(c0), chi2s = (double(sub) - es) * (double(sub) - es) / es +
-                                               (double(c0 - sub) - 3 * es) * (double(c0 - sub) - 3 * es) / (3 * es);
+  const double es = 0.25 * double(c0),
+               chi2s = (double(sub) - es) * (double(sub) - es) / es +
+                       (double(c0 - sub) - 3 * es) * (double(c0 - sub) - 3 * es) / (3 * es);
   EXPECT_LT(chi2s, 10.83);
   // Thread-count independent.
   Context one(1);
@@ -108,7 +110,8 @@ TEST(Bezier, EndpointsDerivativeAndLength) {
   EXPECT_NEAR(b.arc_length(0, 0.4) + b.arc_length(0.4, 1), b.arc_length(), 1e-10);
   const auto even = b.sample_by_length(5);
   for (std::size_t i = 1; i < even.size(); ++i)
-    EXPECT_NEAR(b.arc_length(b.closest_parameter(even[i - 1]), b.closest_parameter(even[i])), b.arc_length() / 4, 1e-6);
+    EXPECT_NEAR(b.arc_length(b.closest_parameter(even[i - 1]), b.closest_parameter(even[i])),
+                b.arc_length() / 4, 1e-6);
   // Split halves meet and reproduce the curve.
   const auto halves = b.split(0.3);
   EXPECT_NEAR((halves[0].eval(1) - b.eval(0.3)).norm(), 0, 1e-12);
@@ -140,7 +143,8 @@ TEST(Bezier, ClosestParameterMatchesDenseSearch) {
 }
 
 TEST(CatmullRom, InterpolatesAndDerivativesAgree) {
-  std::vector<Vec3> pts = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1.1, 1, 0), Vec3(3, 1, 0.5), Vec3(3, 3, 1)};
+  std::vector<Vec3> pts = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1.1, 1, 0), Vec3(3, 1, 0.5),
+                           Vec3(3, 3, 1)};
   for (double alpha : {0.0, 0.5, 1.0})
     for (bool closed : {false, true}) {
       const CatmullRom3 c(pts, alpha, closed);
@@ -159,7 +163,8 @@ TEST(CatmullRom, InterpolatesAndDerivativesAgree) {
         // Non-uniform splines are C1 in knot time t (tangent = d/du / dt_i), so G1 in s; the
         // uniform one is C1 in s.
         const Vec3 left = c.segment(k - 1).derivative(1.0), right = c.segment(k).derivative(0.0);
-        EXPECT_NEAR((left.normalized() - right.normalized()).norm(), 0, 1e-9) << alpha << " knot " << k;
+        EXPECT_NEAR((left.normalized() - right.normalized()).norm(), 0, 1e-9)
+            << alpha << " knot " << k;
         if (alpha == 0.0) {
           EXPECT_NEAR((left - right).norm(), 0, 1e-12);
         }

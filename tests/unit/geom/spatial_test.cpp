@@ -22,7 +22,8 @@ TriMesh random_soup(uint64_t seed, int n) {
   for (int f = 0; f < n; ++f) {
     const Vec3 c(rng.uniform(), rng.uniform(), rng.uniform());
     for (int k = 0; k < 3; ++k)
-      m.positions.push_back(c + 0.1 * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)));
+      m.positions.push_back(c +
+                            0.1 * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)));
     m.faces.emplace_back(3 * f, 3 * f + 1, 3 * f + 2);
   }
   return m;
@@ -44,8 +45,9 @@ double brute_closest(const TriMesh& m, const Vec3& p) {
 TEST(ClosestPointOnTriangle, RegionsAgainstDenseSampling) {
   Rng rng(7);
   for (int trial = 0; trial < 200; ++trial) {
-    const Vec3 a(rng.normal(), rng.normal(), rng.normal()), b(rng.normal(), rng.normal(), rng.normal()),
-        c(rng.normal(), rng.normal(), rng.normal()), p(2 * rng.normal(), 2 * rng.normal(), 2 * rng.normal());
+    const Vec3 a(rng.normal(), rng.normal(), rng.normal()),
+        b(rng.normal(), rng.normal(), rng.normal()), c(rng.normal(), rng.normal(), rng.normal()),
+        p(2 * rng.normal(), 2 * rng.normal(), 2 * rng.normal());
     const Vec3 w = closest_point_on_triangle(p, a, b, c);
     EXPECT_NEAR(w.sum(), 1.0, 1e-12);
     EXPECT_GE(w.minCoeff(), -1e-12);
@@ -65,7 +67,8 @@ TEST(MeshQuery, ClosestPointMatchesBruteForce) {
   const MeshQuery q(m);
   Rng rng(11);
   std::vector<Vec3> pts;
-  for (int i = 0; i < 400; ++i) pts.emplace_back(rng.uniform(-0.3, 1.3), rng.uniform(-0.3, 1.3), rng.uniform(-0.3, 1.3));
+  for (int i = 0; i < 400; ++i)
+    pts.emplace_back(rng.uniform(-0.3, 1.3), rng.uniform(-0.3, 1.3), rng.uniform(-0.3, 1.3));
   Context ctx(2);
   const auto batch = q.closest_points(ctx, pts);
   for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -75,7 +78,8 @@ TEST(MeshQuery, ClosestPointMatchesBruteForce) {
     EXPECT_EQ(batch[i].distance, cp.distance);
     // Barycentrics reproduce the point, the point is at the reported distance.
     const Vec3i& f = m.faces[std::size_t(cp.face)];
-    const Vec3 x = cp.bary[0] * m.positions[std::size_t(f[0])] + cp.bary[1] * m.positions[std::size_t(f[1])] +
+    const Vec3 x = cp.bary[0] * m.positions[std::size_t(f[0])] +
+                   cp.bary[1] * m.positions[std::size_t(f[1])] +
                    cp.bary[2] * m.positions[std::size_t(f[2])];
     EXPECT_NEAR((x - cp.point).norm(), 0, 1e-12);
     EXPECT_NEAR((cp.point - pts[i]).norm(), cp.distance, 1e-12);
@@ -129,12 +133,15 @@ TEST(MeshQuery, RayHitsMatchBruteForceOnPlane) {
   }
 }
 
-TEST(MeshQuery, EmptyMeshIsAnError) { EXPECT_THROW(MeshQuery(TriMesh{}), Error); }
+TEST(MeshQuery, EmptyMeshIsAnError) {
+  EXPECT_THROW(MeshQuery(TriMesh{}), Error);
+}
 
 TEST(NeighbourGrid, QueryAndPairsMatchBruteForce) {
   Rng rng(21);
   std::vector<Vec3f> pts;
-  for (int i = 0; i < 3000; ++i) pts.emplace_back(float(rng.uniform()), float(rng.uniform(0, 0.5)), float(rng.uniform()));
+  for (int i = 0; i < 3000; ++i)
+    pts.emplace_back(float(rng.uniform()), float(rng.uniform(0, 0.5)), float(rng.uniform()));
   pts.push_back(pts[5]);  // duplicate point
   const float r = 0.06f;
   auto within = [&](const Vec3f& a, const Vec3f& b, float rr) {
@@ -146,7 +153,8 @@ TEST(NeighbourGrid, QueryAndPairsMatchBruteForce) {
     NeighbourGrid g;
     g.build(ctx, pts, r);
     for (int t = 0; t < 100; ++t) {
-      const Vec3f p(float(rng.uniform(-0.1, 1.1)), float(rng.uniform(-0.1, 0.6)), float(rng.uniform(-0.1, 1.1)));
+      const Vec3f p(float(rng.uniform(-0.1, 1.1)), float(rng.uniform(-0.1, 0.6)),
+                    float(rng.uniform(-0.1, 1.1)));
       for (float rr : {0.5f * r, r, 3.0f * r}) {
         std::vector<uint32_t> expect;
         for (uint32_t i = 0; i < pts.size(); ++i)
@@ -202,9 +210,11 @@ TEST(MeshQuery, DefaultHeadClosestPointSpotCheck) {
   Rng rng(2);
   const auto box = head.bounds();
   for (int i = 0; i < 20; ++i) {
-    const Vec3 p = box.min() + Vec3(rng.uniform(), rng.uniform(), rng.uniform()).cwiseProduct(box.sizes());
+    const Vec3 p =
+        box.min() + Vec3(rng.uniform(), rng.uniform(), rng.uniform()).cwiseProduct(box.sizes());
     EXPECT_NEAR(q.closest_point(p).distance, brute_closest(head, p), 1e-12);
   }
   // Vertices lie on the surface.
-  for (std::size_t v = 0; v < head.num_vertices(); v += 997) EXPECT_NEAR(q.closest_point(head.positions[v]).distance, 0, 1e-12);
+  for (std::size_t v = 0; v < head.num_vertices(); v += 997)
+    EXPECT_NEAR(q.closest_point(head.positions[v]).distance, 0, 1e-12);
 }

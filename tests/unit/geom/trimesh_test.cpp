@@ -1,10 +1,11 @@
 // TriMesh, StrandSet, ParticleSet and adjacency.
+#include "follicle/geom/trimesh.hpp"
+
 #include <gtest/gtest.h>
 
 #include "follicle/core/error.hpp"
 #include "follicle/geom/adjacency.hpp"
 #include "follicle/geom/strands.hpp"
-#include "follicle/geom/trimesh.hpp"
 
 using namespace follicle;
 using namespace follicle::geom;

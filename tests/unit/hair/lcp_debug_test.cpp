@@ -28,7 +28,7 @@ TEST(LcpDebug, DISABLED_Hang) {
       if (ws.k[q] == 0) ++broken;
     }
     double miny = 1e9; for (auto& x : s.x) miny = std::min(miny, x.y());
-    if (k % 5 == 0) std::printf("step %d ok %d vmax %.3f broken %d maxratio %.2f mean %.3f miny %.3f\n", k, rep.ok, rep.max_speed, broken, maxr, meanr / m.num_pairs(), miny);
+    if (k % 5 == 0) std::printf("step %d sub %d ok %d vmax %.3f broken %d maxratio %.2f mean %.3f miny %.3f\n", k, rep.substeps, rep.ok, rep.max_speed, broken, maxr, meanr / m.num_pairs(), miny);
   }
 }
 TEST(LcpDebug, DISABLED_Lattice) {
@@ -48,6 +48,8 @@ TEST(LcpDebug, DISABLED_Lattice) {
   auto model = connect_particles(ctx, x, t, uvs, std::vector<double>(x.size(), 3.3e-5), ip);
   LcpParams p;
   p.hair_hair = false;
+  if (std::getenv("SUB")) p.substeps = std::atoi(std::getenv("SUB"));
+  if (std::getenv("CS")) p.compression_scale = std::atof(std::getenv("CS"));
   if (std::getenv("E")) p.elastic_modulus = std::atof(std::getenv("E"));
   LcpSolver solver(p, model);
   LcpState s = solver.rest_state();

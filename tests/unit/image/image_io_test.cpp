@@ -1,3 +1,5 @@
+#include "follicle/image/image_io.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -5,7 +7,6 @@
 #include <limits>
 
 #include "follicle/core/atomic_file.hpp"
-#include "follicle/image/image_io.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;

@@ -1,8 +1,8 @@
+#include "follicle/image/metrics.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "follicle/image/metrics.hpp"
 
 using namespace follicle;
 using namespace follicle::image;

@@ -1,8 +1,8 @@
+#include "follicle/image/raster.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "follicle/image/raster.hpp"
 
 using namespace follicle;
 using namespace follicle::image;

@@ -42,7 +42,8 @@ RenderSettings small(int w = 128, int h = 128) {
 }
 
 void maybe_save(const image::ImageRGBA8& img, const std::string& name) {
-  if (const char* d = std::getenv("FOLLICLE_RENDER_TEST_OUT")) image::write_png(std::filesystem::path(d) / name, img);
+  if (const char* d = std::getenv("FOLLICLE_RENDER_TEST_OUT"))
+    image::write_png(std::filesystem::path(d) / name, img);
 }
 
 }  // namespace
@@ -103,7 +104,9 @@ TEST(Lafortune, MirrorValueAndReciprocity) {
 
 class Renderer_ : public RenderTest {};
 
-TEST_F(Renderer_, DescribesDevice) { EXPECT_FALSE(renderer().device_description().empty()); }
+TEST_F(Renderer_, DescribesDevice) {
+  EXPECT_FALSE(renderer().device_description().empty());
+}
 
 TEST_F(Renderer_, LitSphereAndBackground) {
   const RenderScene s = sphere_scene();
@@ -247,7 +250,8 @@ TEST_F(Renderer_, SameSceneGivesSameBytes) {
   auto st = std::make_shared<geom::StrandSet>();
   for (int i = 0; i < 50; ++i) {
     const float a = float(i) * 0.12f;
-    st->add_strand({Vec3f(std::cos(a), 1.0f, std::sin(a)), Vec3f(1.3f * std::cos(a), 0.2f, 1.3f * std::sin(a)),
+    st->add_strand({Vec3f(std::cos(a), 1.0f, std::sin(a)),
+                    Vec3f(1.3f * std::cos(a), 0.2f, 1.3f * std::sin(a)),
                     Vec3f(1.4f * std::cos(a), -0.6f, 1.4f * std::sin(a))});
   }
   StrandItem it;
@@ -289,7 +293,8 @@ TEST_F(Renderer_, LafortuneShaderMatchesCpuBrdf) {
   s.meshes.push_back(m);
   const auto img = renderer().render(s, small(64, 64));
   const Vec3 wi(std::sin(th), 0, std::cos(th));
-  const Vec3 expect = kPi * eval_lafortune(m.material.lafortune, Vec3(0, 0, 1), wi) * std::cos(th) * 1.2;
+  const Vec3 expect =
+      kPi * eval_lafortune(m.material.lafortune, Vec3(0, 0, 1), wi) * std::cos(th) * 1.2;
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.at(32, 32, c), linear_to_srgb8(expect[c]), 1.5) << c;
 }
 
@@ -335,7 +340,8 @@ TEST_F(Renderer_, BumpAndNormalMapsTiltTheNormal) {
   const auto flat = renderer().render(s, small(64, 64));
   auto h = std::make_shared<image::ImageF>(32, 32);
   for (int y = 0; y < 32; ++y)
-    for (int x = 0; x < 32; ++x) h->at(x, y) = 0.5f * (x + 0.5f) / 32.0f;  // slope 0.5 per UV = 0.25 per m
+    for (int x = 0; x < 32; ++x)
+      h->at(x, y) = 0.5f * (x + 0.5f) / 32.0f;  // slope 0.5 per UV = 0.25 per m
   s.meshes[0].material.height_map = h;
   const auto bumped = renderer().render(s, small(64, 64));
   // Expected: n' = normalize(-0.25, 0, 1); diffuse = 0.5 * n'.L with L = (-1, 0, 1)/sqrt2.

@@ -237,3 +237,10 @@ TEST(JsonDoc, EveryKeyHasARowWithTypeUnitDefaultAndRange) {
   const std::string table = doc_table(rows);
   EXPECT_THAT(table, HasSubstr("| `speed` | number | m/s |"));
 }
+
+TEST(JsonReader, SuggestionPrefersTruncatedNames) {
+  // "fov" is closer to "far" by edit distance, but a truncated "fov_deg" is the likelier intent.
+  EXPECT_EQ(suggest("fov", {"eye", "far", "fov_deg"}), "fov_deg");
+  EXPECT_EQ(suggest("widht", {"width", "height"}), "width");
+  EXPECT_EQ(suggest("zzzzzz", {"width", "height"}), "");
+}

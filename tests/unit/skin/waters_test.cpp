@@ -13,12 +13,12 @@ using namespace follicle::skin;
 
 TEST(WatersMuscle, ContractionMovesTowardOriginInsideZoneOnly) {
   Context ctx(1);
-  const geom::TriMesh m = make_cylinder_patch(0.08, 0.08, 1e4, 0.002);
+  const geom::TriMesh m = make_cylinder_patch(0.08, 0.08, 0.0, 0.002);
   MuscleSet set;
   LinearMuscle lm;
   lm.name = "test";
-  lm.origin = Vec3(0, 0.03, 1e4);
-  lm.insertion = Vec3(0, -0.01, 1e4);
+  lm.origin = Vec3(0, 0.03, 0);
+  lm.insertion = Vec3(0, -0.01, 0);
   lm.falloff_start = 0.01;
   lm.falloff_end = 0.05;
   lm.zone = 0.5;
@@ -51,10 +51,10 @@ TEST(WatersMuscle, ContractionMovesTowardOriginInsideZoneOnly) {
 
 TEST(WatersMuscle, JawRotatesOnlyJawRegion) {
   Context ctx(1);
-  const geom::TriMesh m = make_cylinder_patch(0.08, 0.08, 1e4, 0.004);
+  const geom::TriMesh m = make_cylinder_patch(0.08, 0.08, 0.0, 0.004);
   MuscleSet set;
   set.jaw.enabled = true;
-  set.jaw.pivot = Vec3(0, 0, 1e4 - 0.05);
+  set.jaw.pivot = Vec3(0, 0, -0.05);
   set.jaw.axis = Vec3(1, 0, 0);
   set.jaw.plane_normal = Vec3(0, -1, 0);
   set.jaw.offset = 0.01;
