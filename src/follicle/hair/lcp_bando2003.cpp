@@ -110,6 +110,8 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
     double l0, c, ca, cb, strength;
   };
   std::vector<Cand> cands;
+  std::vector<Cand> fallback(n);
+  std::vector<double> fallback_a(n, 0.0);
   for (std::size_t i = 0; i < n; ++i)
     for (uint32_t q = off[i]; q < off[i + 1]; ++q) {
       const uint32_t j = nb[q];
@@ -123,7 +125,18 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
       // sign test of (3.6)).
       const double ci = t[i].dot(xh), cj = t[j].dot(xh);
       const double a = ci * cj > 0 ? std::abs((ci + cj) / 2) : 0.0;  // (3.6)
-      if (a <= 0 || a < p.a0) continue;
+      if (a <= 0) continue;
+      if (a < p.a0) {
+        // Remember the best root-side partner of each end: a particle without any root-side
+        // connection would fall off freely (added below; not in the paper).
+        const uint32_t tip = ci > 0 ? j : uint32_t(i);
+        if (a > fallback_a[tip]) {
+          fallback_a[tip] = a;
+          fallback[tip] = ci > 0 ? Cand{uint32_t(i), j, l0, a * l0, ci, cj, 0}
+                                 : Cand{j, uint32_t(i), l0, a * l0, -cj, -ci, 0};
+        }
+        continue;
+      }
       Cand c;
       if (ci > 0) {  // j lies towards the tip of i
         c = {uint32_t(i), j, l0, a * l0, ci, cj, 0};
@@ -134,7 +147,18 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
       c.strength = c.c * sph_w(m.h_s, l0);    // initial spring coefficient (3.7)
       cands.push_back(c);
     }
-  // Remove the weakest connections while both ends keep more than N_n.
+  {
+    std::vector<char> has_root_side(n, 0);
+    for (const auto& c : cands) has_root_side[c.b] = 1;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!m.root[i] && !has_root_side[i] && fallback_a[i] > 0) {
+        Cand c = fallback[i];
+        c.strength = c.c * sph_w(m.h_s, c.l0);
+        cands.push_back(c);
+      }
+  }
+  // Remove the weakest connections while both ends keep more than N_n (never a tip-side end's
+  // last root-side connection).
   std::vector<uint32_t> order(cands.size());
   std::iota(order.begin(), order.end(), 0u);
   std::stable_sort(order.begin(), order.end(), [&](uint32_t u, uint32_t w) {
@@ -145,13 +169,16 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
     ++deg[c.a];
     ++deg[c.b];
   }
+  std::vector<int> nroot(n, 0);
+  for (const auto& c : cands) ++nroot[c.b];
   std::vector<char> keep(cands.size(), 1);
   for (uint32_t q : order) {
     const auto& c = cands[q];
-    if (deg[c.a] > p.n_n && deg[c.b] > p.n_n) {
+    if (deg[c.a] > p.n_n && deg[c.b] > p.n_n && nroot[c.b] > 1) {
       keep[q] = 0;
       --deg[c.a];
       --deg[c.b];
+      --nroot[c.b];
     }
   }
   for (std::size_t q = 0; q < cands.size(); ++q) {

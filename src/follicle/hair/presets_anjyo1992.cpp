@@ -66,7 +66,7 @@ HairStyle bob(double ds) {
   HairPart main;
   main.name = "main";
   main.pores = scalp(dens, 0.24, 0.04);
-  main.beam.flexural_rigidity = 6e-8;
+  main.beam.flexural_rigidity = 5e-9;
   // Parting at the middle (Fig. 5b): above the eyes, the left half is combed to the left and
   // the right half to the right, slightly backwards.
   main.fields.push_back(uniform({9.0, 0.0, -2.0}, polar(0.0, kPi), 0.15));
@@ -75,7 +75,7 @@ HairStyle bob(double ds) {
   HairPart bangs;
   bangs.name = "bangs";
   bangs.pores = {region(-0.75, 0.75, 0.45, 0.95, dens, 0.16, 0.03)};
-  bangs.beam.flexural_rigidity = 6e-8;
+  bangs.beam.flexural_rigidity = 4e-9;
   bangs.fields.push_back(uniform({0.0, 0.0, 10.0}, polar(-kPi, kPi), 0.3));  // comb forward
   bangs.cuts.push_back(cut_below(0.32));  // short bangs above the eyebrows
   st.parts = {main, bangs};
@@ -90,7 +90,7 @@ HairStyle swept_back(double ds) {
   main.name = "main";
   main.pores = scalp(dens, 0.2, 0.06);
   main.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.2, 0.06));
-  main.beam.flexural_rigidity = 5e-8;
+  main.beam.flexural_rigidity = 5e-9;
   // Force from the face backwards (Fig. 6b) on the segments above the eyes.
   main.fields.push_back(uniform({0.0, 2.0, -16.0}, polar(-kPi, kPi), 0.05));
   main.cuts.push_back(cut_below(-1.2));
@@ -98,7 +98,7 @@ HairStyle swept_back(double ds) {
   tuft.name = "temple_tuft";
   tuft.pores = {region(1.05, 1.35, 1.2, 1.5, dens * 1.5, 0.09, 0.1),
                 region(-1.35, -1.05, 1.2, 1.5, dens * 1.5, 0.09, 0.1)};
-  tuft.beam.flexural_rigidity = 2e-8;
+  tuft.beam.flexural_rigidity = 2e-9;
   tuft.fields.push_back(uniform({0.0, 0.0, 4.0}, polar(-kPi, kPi)));
   st.parts = {main, tuft};
   return st;
@@ -112,7 +112,7 @@ HairStyle ponytail(double ds) {
   tied.name = "ponytail";
   tied.pores = scalp(dens, 0.38, 0.08);
   tied.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.38, 0.08));
-  tied.beam.flexural_rigidity = 8e-8;
+  tied.beam.flexural_rigidity = 6e-9;
   tied.tie.enabled = true;
   tied.tie.point = Vec3(0.0, 0.25, -1.0);
   tied.tie.radius = 0.01;
@@ -129,7 +129,7 @@ HairStyle short_cut(double ds) {
   main.name = "main";
   main.pores = scalp(dens, 0.12, 0.05);
   main.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.12, 0.05));
-  main.beam.flexural_rigidity = 2.5e-8;
+  main.beam.flexural_rigidity = 4e-9;
   main.fields.push_back(uniform({0.0, 0.0, -5.0}, polar(-kPi, kPi), -0.2));
   // Fig. 6d: how much is cut depends on the pore height: short at the nape, long on top.
   CutRule c;

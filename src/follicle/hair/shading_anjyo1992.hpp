@@ -18,8 +18,8 @@ struct AnjyoShadingParams {
   double ambient_intensity = 1.0;      // Ia
   double ka_mean = 0.8;                // mean of the per-strand ambient coefficient ka
   double ka_sigma = 0.15;              // standard deviation of ka (normal distribution)
-  double ks = 0.35;                    // specular coefficient
-  double exponent = 60.0;              // n, sharpness of the highlight
+  double ks = 0.25;                    // specular coefficient
+  double exponent = 120.0;             // n, sharpness of the highlight
   double light_intensity = 1.0;        // Is
   template <class V>
   void visit(V&& v) {

@@ -158,3 +158,15 @@ TEST(SceneDocs, SceneFormatDocIsInSync) {
   EXPECT_EQ(update_scene_doc(read_file(doc)), read_file(doc));
   EXPECT_TRUE(stale_scene_doc_blocks(update_scene_doc("# x\n")).empty());
 }
+
+TEST(SceneDocs, ExampleInTheDocIsTheShippedDefaultScene) {
+  const std::string doc = read_file(test::source_dir() / "docs" / "scene-format.md");
+  const auto b = doc.find("```json\n");
+  ASSERT_NE(b, std::string::npos);
+  const auto e = doc.find("```", b + 8);
+  ASSERT_NE(e, std::string::npos);
+  const std::string example = doc.substr(b + 8, e - b - 8);
+  EXPECT_NO_THROW(read_scene(parse_json_text(example, "example"), JsonSource{"example"}));
+  EXPECT_EQ(parse_json_text(example, "example"),
+            parse_json_file(test::source_dir() / "data" / "scenes" / "default.json"));
+}
