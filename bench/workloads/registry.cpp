@@ -11,12 +11,16 @@ namespace follicle::workloads {
 void add_geom_workloads(std::vector<Workload>& out);
 void add_render_workloads(std::vector<Workload>& out);
 void add_fine_workloads(std::vector<Workload>& out);
+void add_anjyo_workloads(std::vector<Workload>& out);
+void add_skin_workloads(std::vector<Workload>& out);
 
 std::vector<Workload> all_workloads() {
   std::vector<Workload> out;
   add_geom_workloads(out);
   add_render_workloads(out);
   add_fine_workloads(out);
+  add_anjyo_workloads(out);
+  add_skin_workloads(out);
   return out;
 }
 

@@ -30,7 +30,8 @@ Vec3 root_direction(const Vec3& n_w, const Vec3& n, double w_t, double w_n) {
 
 std::vector<double> sph_density(const Context& ctx, const std::vector<Vec3>& x,
                                 const std::vector<double>& mass, double h) {
-  if (x.size() != mass.size()) fail("sph_density: {} positions but {} masses", x.size(), mass.size());
+  if (x.size() != mass.size())
+    fail("sph_density: {} positions but {} masses", x.size(), mass.size());
   if (!(h > 0)) fail("sph_density: smoothing length {} must be > 0", h);
   ParticleGrid grid;
   grid.build(x, 2 * h);
@@ -143,8 +144,8 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
       } else {
         c = {j, uint32_t(i), l0, a * l0, -cj, -ci, 0};
       }
-      c.c = a * l0;                           // (3.5) c_ij = a_ij l0_ij
-      c.strength = c.c * sph_w(m.h_s, l0);    // initial spring coefficient (3.7)
+      c.c = a * l0;                         // (3.5) c_ij = a_ij l0_ij
+      c.strength = c.c * sph_w(m.h_s, l0);  // initial spring coefficient (3.7)
       cands.push_back(c);
     }
   {
@@ -161,9 +162,8 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
   // last root-side connection).
   std::vector<uint32_t> order(cands.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t u, uint32_t w) {
-    return cands[u].strength < cands[w].strength;
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t u, uint32_t w) { return cands[u].strength < cands[w].strength; });
   std::vector<int> deg(n, 0);
   for (const auto& c : cands) {
     ++deg[c.a];
@@ -218,7 +218,9 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
 namespace {
 
 uint64_t cell_key(const Vec3& p, double s, double r) {
-  auto f = [](double v) { return uint64_t(uint32_t(int64_t(std::floor(v)) + (1 << 15)) & 0xFFFFu); };
+  auto f = [](double v) {
+    return uint64_t(uint32_t(int64_t(std::floor(v)) + (1 << 15)) & 0xFFFFu);
+  };
   return f(p.x() / r) | (f(p.y() / r) << 16) | (f(p.z() / r) << 32) | (f(s / r) << 48);
 }
 
@@ -558,8 +560,8 @@ void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWork
       const Vec3 d = s.x[j] - s.x[i];
       const double r = d.norm();
       if (r <= 0) continue;
-      const Vec3 xh = d / r;                                // x^_ij
-      const double c0 = is_a ? m.cos_a[q] : -m.cos_b[q];    // cos theta0_ij against x_ij
+      const Vec3 xh = d / r;                              // x^_ij
+      const double c0 = is_a ? m.cos_a[q] : -m.cos_b[q];  // cos theta0_ij against x_ij
       const double s0 = std::sqrt(std::max(0.0, 1 - c0 * c0));
       Vec3 perp = ti - ti.dot(xh) * xh;
       const double pn = perp.norm();
@@ -611,7 +613,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
         },
         [](double a, double b) { return std::max(a, b); });
     const double need = std::ceil(in.dt * std::sqrt(w2) / m_params.cfl);
-    if (std::isfinite(need)) nsub = std::max(nsub, int(std::min<double>(need, m_params.max_substeps)));
+    if (std::isfinite(need))
+      nsub = std::max(nsub, int(std::min<double>(need, m_params.max_substeps)));
   }
   const double dt = in.dt / nsub;
   const anim::RigidSample& hd = in.head;
@@ -684,8 +687,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
           Chk c;
           for (std::size_t i = i0; i < i1; ++i) {
             const double sp = s.v[i].norm();
-            const bool bad = !std::isfinite(sp) || !s.x[i].allFinite() || !s.t[i].allFinite() ||
-                             sp > vlim;
+            const bool bad =
+                !std::isfinite(sp) || !s.x[i].allFinite() || !s.t[i].allFinite() || sp > vlim;
             if (bad && c.bad == SIZE_MAX) c.bad = i;
             if (std::isfinite(sp)) c.vmax = std::max(c.vmax, sp);
           }

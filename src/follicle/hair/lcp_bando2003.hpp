@@ -23,21 +23,21 @@ namespace follicle::hair {
 
 /// Particle initialisation and connections (§3.3.1).
 struct LcpInitParams {
-  double spacing = 0.012;        // r [m]: Poisson-disc radius under the distance (3.2)
-  int max_particles = 200000;    // hard cap on the number of particles
+  double spacing = 0.012;          // r [m]: Poisson-disc radius under the distance (3.2)
+  int max_particles = 200000;      // hard cap on the number of particles
   int attempts_per_particle = 40;  // dart throwing stops after this many misses per particle
-  Vec3 whirl_point{0, 1, 0};     // [m] head frame; the nearest scalp vertex is the whirl
-  double w_t = 1.0;              // (3.4) weight of the tangential root direction
-  double w_n = 0.6;              // (3.4) weight of the normal root direction
-  double hs_factor = 1.25;       // h_s = hs_factor * mean nearest-neighbour distance
-  double h_factor = 0.8;         // h = h_factor * mean nearest-neighbour distance
-  double a0 = 0.5;               // minimum alignment a_ij (3.6) of a connection
-  int n_n = 12;                  // N_n: about this many connections per particle
-  double total_mass = 0.05;      // [kg] hair mass shared equally by the particles
-  Vec3 gravity_dir{0, -1, 0};    // head-frame direction of gravity for the cantilever shape
-  double cantilever_sag = 800;   // w/(EI) [1/m^3]: load over bending stiffness of the beam
-  int cantilever_segments = 24;  // segments of the cantilever chain per strand
-  double body_clearance = 0.004; // [m] the initial chain keeps this far from the body planes
+  Vec3 whirl_point{0, 1, 0};       // [m] head frame; the nearest scalp vertex is the whirl
+  double w_t = 1.0;                // (3.4) weight of the tangential root direction
+  double w_n = 0.6;                // (3.4) weight of the normal root direction
+  double hs_factor = 1.25;         // h_s = hs_factor * mean nearest-neighbour distance
+  double h_factor = 0.8;           // h = h_factor * mean nearest-neighbour distance
+  double a0 = 0.5;                 // minimum alignment a_ij (3.6) of a connection
+  int n_n = 12;                    // N_n: about this many connections per particle
+  double total_mass = 0.05;        // [kg] hair mass shared equally by the particles
+  Vec3 gravity_dir{0, -1, 0};      // head-frame direction of gravity for the cantilever shape
+  double cantilever_sag = 800;     // w/(EI) [1/m^3]: load over bending stiffness of the beam
+  int cantilever_segments = 24;    // segments of the cantilever chain per strand
+  double body_clearance = 0.004;   // [m] the initial chain keeps this far from the body planes
   template <class V>
   void visit(V&& v) {
     v("spacing", spacing, ParamInfo{"Poisson-disc radius of (3.2)", "m", 1e-4, 1.0});
@@ -107,22 +107,22 @@ struct LcpParams {
 
 /// Constant per-particle data and the fixed connections.
 struct LcpModel {
-  std::vector<Vec3> uvs;          // (u_i, v_i, s_i)
-  std::vector<double> mass;       // m_i [kg]
-  std::vector<uint8_t> root;      // 1 = root particle (s < 0): fixed to the head
-  std::vector<Vec3> rest_x;       // initial positions (head frame) [m]
-  std::vector<Vec3> rest_t;       // initial hair directions, unit
+  std::vector<Vec3> uvs;      // (u_i, v_i, s_i)
+  std::vector<double> mass;   // m_i [kg]
+  std::vector<uint8_t> root;  // 1 = root particle (s < 0): fixed to the head
+  std::vector<Vec3> rest_x;   // initial positions (head frame) [m]
+  std::vector<Vec3> rest_t;   // initial hair directions, unit
   // Connections, each oriented from its root-side particle a to its tip-side particle b, so
   // b is in N_t(a) and a in N_r(b) (Fig. 3.3 a).
   std::vector<uint32_t> pair_a, pair_b;
-  std::vector<double> l0;         // l0_ij [m]
-  std::vector<double> c;          // c_ij = a_ij l0_ij (3.5)
+  std::vector<double> l0;            // l0_ij [m]
+  std::vector<double> c;             // c_ij = a_ij l0_ij (3.5)
   std::vector<double> cos_a, cos_b;  // cos(theta0) of t_a and t_b against x_ab (both > 0)
   std::vector<uint32_t> adj_offsets, adj_pairs;  // particle -> its connections (CSR)
-  double spacing = 0;             // mean nearest-neighbour distance [m]
-  double h_s = 0;                 // smoothing length of the connections [m]
-  double h = 0;                   // smoothing length of hair-hair interaction [m]
-  double rest_density = 0;        // mean SPH density (3.1) of non-root particles at rest
+  double spacing = 0;                            // mean nearest-neighbour distance [m]
+  double h_s = 0;                                // smoothing length of the connections [m]
+  double h = 0;                                  // smoothing length of hair-hair interaction [m]
+  double rest_density = 0;  // mean SPH density (3.1) of non-root particles at rest
 
   std::size_t size() const { return mass.size(); }
   std::size_t num_pairs() const { return l0.size(); }
@@ -138,29 +138,29 @@ struct LcpState {
 /// What step() reports (the simulation never throws on divergence).
 struct LcpStepReport {
   bool ok = true;
-  std::string message;              // why not ok
-  std::size_t bad_particle = 0;     // first offending particle when !ok
-  int substeps = 0;                 // sub-steps taken
-  double max_speed = 0;             // [m/s] head frame, at the end
-  double max_penetration = 0;       // [m] deepest particle below a body plane (>= 0)
-  std::size_t num_contacts = 0;     // particles in contact at the last sub-step
+  std::string message;           // why not ok
+  std::size_t bad_particle = 0;  // first offending particle when !ok
+  int substeps = 0;              // sub-steps taken
+  double max_speed = 0;          // [m/s] head frame, at the end
+  double max_penetration = 0;    // [m] deepest particle below a body plane (>= 0)
+  std::size_t num_contacts = 0;  // particles in contact at the last sub-step
 };
 
 struct LcpStepInput {
-  double dt = 1.0 / 60.0;                   // [s] split into params.substeps
-  anim::RigidSample head;                   // head/body pose and motion (world)
+  double dt = 1.0 / 60.0;                             // [s] split into params.substeps
+  anim::RigidSample head;                             // head/body pose and motion (world)
   const std::vector<Vec3>* external_force = nullptr;  // [N] world frame per particle (wind)
 };
 
 /// Scratch buffers of a solver (reused between steps; not part of the physical state).
 struct LcpWorkspace {
   ParticleGrid grid;
-  std::vector<uint32_t> nbr_offsets, nbrs;   // current neighbours within 2h
-  std::vector<double> density, pressure;     // (3.1), P = k_a (rho - rho0)
-  std::vector<double> k;                     // k_ij (3.7) per connection
-  std::vector<double> alpha;                 // alpha_ij (3.14) per connection
-  std::vector<double> alpha_r, alpha_t;      // (3.13) per particle
-  std::vector<Vec3> force;                   // [N] head frame
+  std::vector<uint32_t> nbr_offsets, nbrs;  // current neighbours within 2h
+  std::vector<double> density, pressure;    // (3.1), P = k_a (rho - rho0)
+  std::vector<double> k;                    // k_ij (3.7) per connection
+  std::vector<double> alpha;                // alpha_ij (3.14) per connection
+  std::vector<double> alpha_r, alpha_t;     // (3.13) per particle
+  std::vector<Vec3> force;                  // [N] head frame
   std::vector<Vec3> accel;
 };
 

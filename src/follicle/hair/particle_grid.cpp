@@ -68,8 +68,7 @@ void ParticleGrid::neighbour_lists(const Context& ctx, const std::vector<Vec3>& 
 
 void ParticleGrid::cross_lists(const Context& ctx, const std::vector<Vec3>& queries,
                                const std::vector<Vec3>& grid_points, double radius,
-                               std::vector<uint32_t>& offsets,
-                               std::vector<uint32_t>& nbrs) const {
+                               std::vector<uint32_t>& offsets, std::vector<uint32_t>& nbrs) const {
   const double r2 = radius * radius;
   build_lists(ctx, queries.size(), offsets, nbrs, [&](std::size_t i, std::vector<uint32_t>& out) {
     const Vec3& p = queries[i];

@@ -72,6 +72,7 @@ HairStyle bob(double ds) {
   main.fields.push_back(uniform({9.0, 0.0, -2.0}, polar(0.0, kPi), 0.15));
   main.fields.push_back(uniform({-9.0, 0.0, -2.0}, polar(-kPi, 0.0), 0.15));
   main.cuts.push_back(cut_below(-1.15));  // the bob line at the jaw
+  main.cuts.push_back(cut_below(0.3, polar(-0.9, 0.9)));  // hair falling over the face: bangs
   HairPart bangs;
   bangs.name = "bangs";
   bangs.pores = {region(-0.75, 0.75, 0.45, 0.95, dens, 0.16, 0.03)};
@@ -92,7 +93,7 @@ HairStyle swept_back(double ds) {
   main.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.2, 0.06));
   main.beam.flexural_rigidity = 5e-9;
   // Force from the face backwards (Fig. 6b) on the segments above the eyes.
-  main.fields.push_back(uniform({0.0, 2.0, -16.0}, polar(-kPi, kPi), 0.05));
+  main.fields.push_back(uniform({0.0, 1.0, -7.0}, polar(-kPi, kPi), 0.05));
   main.cuts.push_back(cut_below(-1.2));
   HairPart tuft;  // the tuft at the side of the temple
   tuft.name = "temple_tuft";
@@ -129,7 +130,7 @@ HairStyle short_cut(double ds) {
   main.name = "main";
   main.pores = scalp(dens, 0.12, 0.05);
   main.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.12, 0.05));
-  main.beam.flexural_rigidity = 4e-9;
+  main.beam.flexural_rigidity = 1.5e-9;
   main.fields.push_back(uniform({0.0, 0.0, -5.0}, polar(-kPi, kPi), -0.2));
   // Fig. 6d: how much is cut depends on the pore height: short at the nape, long on top.
   CutRule c;

@@ -18,9 +18,9 @@
 namespace follicle::hair {
 
 struct ScalpParams {
-  double root_depth = 0.003;    // s_r [m], depth of the hair root beneath the scalp
-  double max_length = 0.25;     // [m] hair length where the length map is white
-  int curve_samples = 64;       // samples per Catmull-Rom curve for trimming
+  double root_depth = 0.003;  // s_r [m], depth of the hair root beneath the scalp
+  double max_length = 0.25;   // [m] hair length where the length map is white
+  int curve_samples = 64;     // samples per Catmull-Rom curve for trimming
   template <class V>
   void visit(V&& v) {
     v("root_depth", root_depth, ParamInfo{"root depth s_r beneath the scalp", "m", 0.0, 1.0});
@@ -59,7 +59,7 @@ class Scalp {
   /// (u, v) of the scalp vertex nearest to a world point (e.g. the whirl).
   Vec2 nearest_uv(const Vec3& p) const;
 
-  const geom::TriMesh& mesh() const { return m_mesh; }   // trimmed scalp, uvs = embedding
+  const geom::TriMesh& mesh() const { return m_mesh; }  // trimmed scalp, uvs = embedding
   const std::vector<int>& source_vertices() const { return m_source; }  // head vertex ids
   double root_depth() const { return m_params.root_depth; }
   double max_length() const { return m_params.max_length; }

@@ -42,7 +42,8 @@ TEST(LcpDensity, RegularLatticeMatchesAnalyticValue) {
   double lattice = 0;
   for (int i = -2; i <= 2; ++i)
     for (int j = -2; j <= 2; ++j)
-      for (int k = -2; k <= 2; ++k) lattice += m * sph_w(h, a * std::sqrt(double(i * i + j * j + k * k)));
+      for (int k = -2; k <= 2; ++k)
+        lattice += m * sph_w(h, a * std::sqrt(double(i * i + j * j + k * k)));
   const std::size_t centre = (4 * n + 4) * n + 4;
   EXPECT_NEAR(rho[centre], lattice, 1e-9 * lattice);
   EXPECT_NEAR(rho[centre], m / (a * a * a), 0.01 * m / (a * a * a));
@@ -81,12 +82,15 @@ TEST(LcpInit, ParticlesFillThePillarAndRootsAreBelowTheScalp) {
   EXPECT_GE(dmin, 0.012 * (1 - 1e-9));
   // Connections: every pair aligned at least a0, about N_n per particle.
   double deg = 0;
+  std::size_t below_a0 = 0;  // fallback: a particle's only root-side connection
   for (std::size_t q = 0; q < m.num_pairs(); ++q) {
-    EXPECT_GE(m.c[q] / m.l0[q], 0.5 - 1e-12);
+    EXPECT_GT(m.c[q] / m.l0[q], 0.0);
+    if (m.c[q] / m.l0[q] < 0.5) ++below_a0;
     EXPECT_GT(m.cos_a[q], 0);
     EXPECT_GT(m.cos_b[q], 0);
     EXPECT_LT(m.l0[q], 2 * m.h_s);
   }
+  EXPECT_LT(below_a0, m.size() / 10);
   deg = 2.0 * double(m.num_pairs()) / double(m.size());
   EXPECT_GT(deg, 4.0);
   EXPECT_LE(deg, 12.5);
@@ -282,10 +286,10 @@ TEST(LcpParams, MalformedInputFailsCleanly) {
   EXPECT_THROW(connect_particles(ctx, {Vec3(0, 0, 0), Vec3(0, 0, 0.01)}, {Vec3(0, 0, 1)},
                                  {Vec3::Zero(), Vec3::Zero()}, {1e-5, 1e-5}, ip),
                Error);
-  EXPECT_THROW(connect_particles(ctx, {Vec3(0, 0, 0), Vec3(0, 0, 0.01)},
-                                 {Vec3(0, 0, 1), Vec3(0, 0, 1)}, {Vec3::Zero(), Vec3::Zero()},
-                                 {1e-5, -1.0}, ip),
-               Error);
+  EXPECT_THROW(
+      connect_particles(ctx, {Vec3(0, 0, 0), Vec3(0, 0, 0.01)}, {Vec3(0, 0, 1), Vec3(0, 0, 1)},
+                        {Vec3::Zero(), Vec3::Zero()}, {1e-5, -1.0}, ip),
+      Error);
   auto init = initialize_lcp(ctx, scalp, ip);
   LcpParams p;
   p.substeps = 0;

@@ -16,8 +16,8 @@ inline geom::TriMesh lcp_sphere(double radius, int nlat = 24, int nlon = 48) {
     const double th = kPi * i / nlat;
     for (int j = 0; j < nlon; ++j) {
       const double ph = 2 * kPi * j / nlon;
-      m.positions.push_back(radius * Vec3(std::sin(th) * std::cos(ph), std::cos(th),
-                                          -std::sin(th) * std::sin(ph)));
+      m.positions.push_back(
+          radius * Vec3(std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph)));
     }
   }
   m.positions.push_back({0, -radius, 0});
