@@ -19,7 +19,11 @@ static void run_anjyo(benchmark::State& state, const char* name) {
   state.SetItemsProcessed(int64_t(double(state.iterations()) * inst->items_per_iter()));
 }
 
-static void BM_AnjyoStyle(benchmark::State& s) { run_anjyo(s, "anjyo-style"); }
-static void BM_AnjyoDynamics(benchmark::State& s) { run_anjyo(s, "anjyo-dynamics"); }
+static void BM_AnjyoStyle(benchmark::State& s) {
+  run_anjyo(s, "anjyo-style");
+}
+static void BM_AnjyoDynamics(benchmark::State& s) {
+  run_anjyo(s, "anjyo-dynamics");
+}
 BENCHMARK(BM_AnjyoStyle)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_AnjyoDynamics)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();

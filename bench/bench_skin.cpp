@@ -19,8 +19,12 @@ void run(benchmark::State& state, const char* name) {
   for (auto _ : state) inst->run_once();
   state.SetItemsProcessed(int64_t(double(state.iterations()) * inst->items_per_iter()));
 }
-void BM_FaceUpdate(benchmark::State& s) { run(s, "face-update"); }
-void BM_HarmonicMap(benchmark::State& s) { run(s, "harmonic-map"); }
+void BM_FaceUpdate(benchmark::State& s) {
+  run(s, "face-update");
+}
+void BM_HarmonicMap(benchmark::State& s) {
+  run(s, "harmonic-map");
+}
 }  // namespace
 
 BENCHMARK(BM_FaceUpdate)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();

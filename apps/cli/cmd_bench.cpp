@@ -46,7 +46,8 @@ int run_bench(const GlobalOptions& g, const BenchArgs& a) {
   if (a.list) {
     for (const auto& w : all) {
       std::string sizes;
-      for (const auto& [k, v] : w.default_sizes) sizes += fmt::format("{}{}={}", sizes.empty() ? "" : " ", k, v);
+      for (const auto& [k, v] : w.default_sizes)
+        sizes += fmt::format("{}{}={}", sizes.empty() ? "" : " ", k, v);
       fmt::print("{:<18} {} [{}] ({})\n", w.name, w.description, sizes, w.throughput_unit);
     }
     return 0;

@@ -23,8 +23,9 @@ int run_docs(const GlobalOptions& g, const DocsArgs& a) {
     if (stale.empty()) return 0;
     std::string names;
     for (const auto& s : stale) names += (names.empty() ? "" : ", ") + s;
-    follicle::fail_at(a.write, "out of date in blocks: {} (run follicle docs scene-format --write {})",
-            names, a.write);
+    follicle::fail_at(a.write,
+                      "out of date in blocks: {} (run follicle docs scene-format --write {})",
+                      names, a.write);
   }
   const std::string after = scene::update_scene_doc(before);
   if (after != before) write_file_atomically(a.write, after);

@@ -32,8 +32,10 @@ void mesh_info(const std::string& path, LengthUnit unit) {
   fmt::print("normals: {}\n", mesh.has_normals() ? "yes" : "no");
   if (mesh.num_vertices() > 0) {
     const Vec3 lo = box.min() * k, hi = box.max() * k, ext = (box.max() - box.min()) * k;
-    fmt::print("bounds min: [{:.6g}, {:.6g}, {:.6g}] {}\n", lo.x(), lo.y(), lo.z(), to_string(unit));
-    fmt::print("bounds max: [{:.6g}, {:.6g}, {:.6g}] {}\n", hi.x(), hi.y(), hi.z(), to_string(unit));
+    fmt::print("bounds min: [{:.6g}, {:.6g}, {:.6g}] {}\n", lo.x(), lo.y(), lo.z(),
+               to_string(unit));
+    fmt::print("bounds max: [{:.6g}, {:.6g}, {:.6g}] {}\n", hi.x(), hi.y(), hi.z(),
+               to_string(unit));
     fmt::print("extent: [{:.6g}, {:.6g}, {:.6g}] {}\n", ext.x(), ext.y(), ext.z(), to_string(unit));
   }
   fmt::print("surface area: {:.6g} m^2\n", area);
@@ -53,8 +55,10 @@ int run_info(const GlobalOptions& g, const InfoArgs& a) {
     mesh_info(a.file, parse_length_unit(a.units));
     return 0;
   }
-  fail_at(a.file, "unknown file type '{}': expected a scene (.json) or a mesh (.obj, .ply, "
-          ".gltf, .glb)", ext);
+  fail_at(a.file,
+          "unknown file type '{}': expected a scene (.json) or a mesh (.obj, .ply, "
+          ".gltf, .glb)",
+          ext);
 }
 
 }  // namespace follicle::cli

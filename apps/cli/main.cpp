@@ -1,8 +1,8 @@
 // follicle: the command-line front end. This is the only file that includes CLI11 (slow to
 // compile); each subcommand's work is in cmd_*.cpp.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -49,7 +49,8 @@ int main(int argc, char** argv) {
   render->add_option("--frame", ra.frame, "frame number to render")->check(CLI::NonNegativeNumber);
 
   ValidateArgs va;
-  auto* validate = app.add_subcommand("validate", "check scene files strictly and load their assets");
+  auto* validate =
+      app.add_subcommand("validate", "check scene files strictly and load their assets");
   validate->add_option("scenes", va.scenes, "scene files (.json)")->required();
 
   InfoArgs ia;

@@ -84,13 +84,17 @@ class DynamicsInstance : public WorkloadInstance {
 }  // namespace
 
 void add_anjyo_workloads(std::vector<Workload>& out) {
-  out.push_back({"anjyo-style", "cantilever styling (Anjyo 1992 §2.1) of the bob's main part",
-                 {{"strands", 100000}, {"segments", 20}}, "strands/s",
+  out.push_back({"anjyo-style",
+                 "cantilever styling (Anjyo 1992 §2.1) of the bob's main part",
+                 {{"strands", 100000}, {"segments", 20}},
+                 "strands/s",
                  [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
                    return std::make_unique<StyleInstance>(ctx, s);
                  }});
-  out.push_back({"anjyo-dynamics", "projective dynamics (Anjyo 1992 §3), one step with a gust",
-                 {{"strands", 100000}, {"segments", 20}}, "steps/s",
+  out.push_back({"anjyo-dynamics",
+                 "projective dynamics (Anjyo 1992 §3), one step with a gust",
+                 {{"strands", 100000}, {"segments", 20}},
+                 "steps/s",
                  [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
                    return std::make_unique<DynamicsInstance>(ctx, s);
                  }});

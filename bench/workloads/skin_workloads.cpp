@@ -1,6 +1,8 @@
 // Skin workloads (issue 4): "face-update" (full muscle -> tissue -> wrinkle update of a
 // 20,000-triangle face with 18 muscles and 10 refined wrinkles) and "harmonic-map" (distortion
 // minimization of a 100,000-vertex mesh).
+#include <fmt/format.h>
+
 #include <cmath>
 #include <memory>
 
@@ -27,7 +29,7 @@ skin::MuscleSet synthetic_muscles(int n) {
   e.name = "all";
   for (int i = 0; i < n; ++i) {
     skin::LinearMuscle m;
-    m.name = "m" + std::to_string(i);
+    m.name = fmt::format("m{}", i);
     const double a = -0.8 + 1.6 * (i % 9) / 8.0, y = i < 9 ? 0.06 : -0.04;
     m.origin = Vec3(0.09 * std::sin(a), y + 0.03, 0.09 * std::cos(a));
     m.insertion = Vec3(0.08 * std::sin(a), y - 0.01, 0.08 * std::cos(a));
@@ -45,10 +47,11 @@ std::vector<skin::LargeWrinkle> synthetic_wrinkles(int n, double size) {
   std::vector<skin::LargeWrinkle> out;
   for (int i = 0; i < n; ++i) {
     skin::LargeWrinkle w;
-    w.name = "w" + std::to_string(i);
+    w.name = fmt::format("w{}", i);
     const double v = 0.1 + 0.8 * (i + 0.5) / n;
     const double u0 = 0.1, u1 = 0.16 / size - 0.1;
-    w.control = {Vec2(u0, v), Vec2(u0 + (u1 - u0) / 3, v + 0.01), Vec2(u0 + 2 * (u1 - u0) / 3, v + 0.01), Vec2(u1, v)};
+    w.control = {Vec2(u0, v), Vec2(u0 + (u1 - u0) / 3, v + 0.01),
+                 Vec2(u0 + 2 * (u1 - u0) / 3, v + 0.01), Vec2(u1, v)};
     w.depth = 0.006;
     w.width = 0.003;
     out.push_back(w);

@@ -8,7 +8,9 @@
 
 namespace follicle::hair {
 
-void CantileverParams::validate() const { validate_params(*this, "cantilever"); }
+void CantileverParams::validate() const {
+  validate_params(*this, "cantilever");
+}
 
 namespace {
 

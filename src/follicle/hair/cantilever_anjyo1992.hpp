@@ -10,17 +10,17 @@
 namespace follicle::hair {
 
 struct CantileverParams {
-  int segments = 20;                  // k: segments per strand (all of the same length d = L/k)
-  double flexural_rigidity = 4e-8;    // E*I [N m²] (human hair: ~1e-8)
-  double linear_density = 6.5e-6;     // ρ [kg/m] (human hair: 6.5e-6)
-  Vec3 gravity{0.0, -9.81, 0.0};      // [m/s²] world
-  bool euler_bernoulli = true;        // true: chord rotation M d/EI per node, which converges to
-                                      // the Euler-Bernoulli deflection; false: eq. (3) literally
-                                      // (half that bending)
-  int load_iterations = 2;            // position-dependent loads are evaluated on the previous
-                                      // pass (pass 0: the straight radial beam of Fig. 4a)
-  double collision_margin = 0.002;    // [m] nodes are kept this far outside the hull
-  bool avoid_mesh = false;            // also push nodes out of the real head (needs a scalp query)
+  int segments = 20;                // k: segments per strand (all of the same length d = L/k)
+  double flexural_rigidity = 4e-8;  // E*I [N m²] (human hair: ~1e-8)
+  double linear_density = 6.5e-6;   // ρ [kg/m] (human hair: 6.5e-6)
+  Vec3 gravity{0.0, -9.81, 0.0};    // [m/s²] world
+  bool euler_bernoulli = true;      // true: chord rotation M d/EI per node, which converges to
+                                    // the Euler-Bernoulli deflection; false: eq. (3) literally
+                                    // (half that bending)
+  int load_iterations = 2;          // position-dependent loads are evaluated on the previous
+                                    // pass (pass 0: the straight radial beam of Fig. 4a)
+  double collision_margin = 0.002;  // [m] nodes are kept this far outside the hull
+  bool avoid_mesh = false;          // also push nodes out of the real head (needs a scalp query)
 
   template <class V>
   void visit(V&& v) {

@@ -117,84 +117,88 @@ void style_roots(const Context& ctx, const sim::Ellipsoid& hull, const HairPart&
   const std::size_t n = roots.size();
   std::vector<Vec3> nodes(n * std::size_t(k + 1));
   std::vector<double> cut_t(n, double(k));  // kept length in segments (fractional)
-  parallel_for(ctx, 0, n, [&](std::size_t s) {
-    Vec3* P = &nodes[s * std::size_t(k + 1)];
-    const Vec2 polar = roots.polar[s];
-    const double L = roots.length[s];
-    const double d = L / k;
-    // Fields acting on this strand (selected by its pore).
-    uint32_t active[32];
-    int na = 0;
-    for (std::size_t f = 0; f < part.fields.size() && na < 32; ++f)
-      if (part.fields[f].pores.contains(polar)) active[na++] = uint32_t(f);
-    SegmentLoadFn extra;
-    if (na > 0) {
-      extra = [&, na, active_ptr = &active[0]](int, const Vec3& mid) {
-        Vec3 a = Vec3::Zero();
-        const Vec3 q = hull.normalized(mid);
-        for (int f = 0; f < na; ++f) {
-          const ForceField& ff = part.fields[active_ptr[f]];
-          if (ff.nodes.contains(q)) a += ff.accel(hull, mid);
-        }
-        return a;
-      };
-    }
-    if (!part.tie.enabled) {
-      bend_strand(part.beam, &hull, roots.position[s], roots.direction[s], L, extra, P, scalp);
-    } else {
-      // Combed along the hull to the tie, then a separately designed tail (Fig. 6c).
-      Rng rng = Rng::stream(seed ^ 0x7A11ull, s);
-      const Vec3 tail_dir = part.tie.tail_direction.normalized();
-      Vec3 e1 = tail_dir.cross(Vec3::UnitX());
-      if (e1.norm() < 1e-6) e1 = tail_dir.cross(Vec3::UnitY());
-      e1.normalize();
-      const Vec3 e2 = tail_dir.cross(e1);
-      // Each strand arrives at its own point of the tie disc.
-      const double rr = part.tie.radius * std::sqrt(rng.uniform());
-      const double ang = 2 * kPi * rng.uniform();
-      const Vec3 tie_s =
-          hull.from_normalized(part.tie.point) + rr * (std::cos(ang) * e1 + std::sin(ang) * e2);
-      P[0] = roots.position[s];
-      const Vec3 qa = hull.normalized(roots.position[s]).normalized();
-      const Vec3 qb = hull.normalized(tie_s).normalized();
-      const auto path = hull_path(hull, part.tie.surface_offset, qa, qb, 96);
-      const int used = walk_path(path, d, k - 1, P);
-      const int m = k - used;
-      // The tail: a cantilever of the remaining m segments hanging from the tie.
-      CantileverParams tb = part.beam;
-      tb.segments = m;
-      Vec3 tail[65];
-      const Vec3 dir_s =
-          (tail_dir + 0.2 * (rng.uniform(-1, 1) * e1 + rng.uniform(-1, 1) * e2)).normalized();
-      bend_strand(tb, &hull, P[used], dir_s, m * d, extra, tail, {});
-      for (int i = 1; i <= m; ++i) P[used + i] = tail[i];
-    }
-    // Cutting.
-    double t = double(k);
-    for (const CutRule& c : part.cuts) {
-      if (!c.pores.contains(polar)) continue;
-      if (c.kind == "threshold") {
-        for (int i = 0; i <= k; ++i) {
-          const double v = c.axis.dot(hull.normalized(P[i])) - c.threshold;
-          if (v < 0) {
-            if (i == 0) {
-              t = 0;
-            } else {
-              const double vp = c.axis.dot(hull.normalized(P[i - 1])) - c.threshold;
-              t = std::min(t, (i - 1) + vp / (vp - v));
+  parallel_for(
+      ctx, 0, n,
+      [&](std::size_t s) {
+        Vec3* P = &nodes[s * std::size_t(k + 1)];
+        const Vec2 polar = roots.polar[s];
+        const double L = roots.length[s];
+        const double d = L / k;
+        // Fields acting on this strand (selected by its pore).
+        uint32_t active[32];
+        int na = 0;
+        for (std::size_t f = 0; f < part.fields.size() && na < 32; ++f)
+          if (part.fields[f].pores.contains(polar)) active[na++] = uint32_t(f);
+        SegmentLoadFn extra;
+        if (na > 0) {
+          extra = [&, na, active_ptr = &active[0]](int, const Vec3& mid) {
+            Vec3 a = Vec3::Zero();
+            const Vec3 q = hull.normalized(mid);
+            for (int f = 0; f < na; ++f) {
+              const ForceField& ff = part.fields[active_ptr[f]];
+              if (ff.nodes.contains(q)) a += ff.accel(hull, mid);
             }
-            break;
+            return a;
+          };
+        }
+        if (!part.tie.enabled) {
+          bend_strand(part.beam, &hull, roots.position[s], roots.direction[s], L, extra, P, scalp);
+        } else {
+          // Combed along the hull to the tie, then a separately designed tail (Fig. 6c).
+          Rng rng = Rng::stream(seed ^ 0x7A11ull, s);
+          const Vec3 tail_dir = part.tie.tail_direction.normalized();
+          Vec3 e1 = tail_dir.cross(Vec3::UnitX());
+          if (e1.norm() < 1e-6) e1 = tail_dir.cross(Vec3::UnitY());
+          e1.normalize();
+          const Vec3 e2 = tail_dir.cross(e1);
+          // Each strand arrives at its own point of the tie disc.
+          const double rr = part.tie.radius * std::sqrt(rng.uniform());
+          const double ang = 2 * kPi * rng.uniform();
+          const Vec3 tie_s =
+              hull.from_normalized(part.tie.point) + rr * (std::cos(ang) * e1 + std::sin(ang) * e2);
+          P[0] = roots.position[s];
+          const Vec3 qa = hull.normalized(roots.position[s]).normalized();
+          const Vec3 qb = hull.normalized(tie_s).normalized();
+          const auto path = hull_path(hull, part.tie.surface_offset, qa, qb, 96);
+          const int used = walk_path(path, d, k - 1, P);
+          const int m = k - used;
+          // The tail: a cantilever of the remaining m segments hanging from the tie.
+          CantileverParams tb = part.beam;
+          tb.segments = m;
+          Vec3 tail[65];
+          const Vec3 dir_s =
+              (tail_dir + 0.2 * (rng.uniform(-1, 1) * e1 + rng.uniform(-1, 1) * e2)).normalized();
+          bend_strand(tb, &hull, P[used], dir_s, m * d, extra, tail, {});
+          for (int i = 1; i <= m; ++i) P[used + i] = tail[i];
+        }
+        // Cutting.
+        double t = double(k);
+        for (const CutRule& c : part.cuts) {
+          if (!c.pores.contains(polar)) continue;
+          if (c.kind == "threshold") {
+            for (int i = 0; i <= k; ++i) {
+              const double v = c.axis.dot(hull.normalized(P[i])) - c.threshold;
+              if (v < 0) {
+                if (i == 0) {
+                  t = 0;
+                } else {
+                  const double vp = c.axis.dot(hull.normalized(P[i - 1])) - c.threshold;
+                  t = std::min(t, (i - 1) + vp / (vp - v));
+                }
+                break;
+              }
+            }
+          } else {
+            const double h = hull.normalized(roots.position[s]).y();
+            const double a =
+                std::clamp((h - c.height_low) / (c.height_high - c.height_low), 0.0, 1.0);
+            const double keep = c.length_low + a * (c.length_high - c.length_low);
+            t = std::min(t, keep / d);
           }
         }
-      } else {
-        const double h = hull.normalized(roots.position[s]).y();
-        const double a = std::clamp((h - c.height_low) / (c.height_high - c.height_low), 0.0, 1.0);
-        const double keep = c.length_low + a * (c.length_high - c.length_low);
-        t = std::min(t, keep / d);
-      }
-    }
-    cut_t[s] = std::max(0.0, t);
-  }, 64);
+        cut_t[s] = std::max(0.0, t);
+      },
+      64);
   // Assemble (serial, in strand order).
   for (std::size_t s = 0; s < n; ++s) {
     const Vec3* P = &nodes[s * std::size_t(k + 1)];
@@ -207,7 +211,8 @@ void style_roots(const Context& ctx, const sim::Ellipsoid& hull, const HairPart&
       continue;
     }
     for (int i = 0; i <= whole; ++i) out.points.push_back(P[i].cast<float>());
-    if (npts > whole + 1) out.points.push_back((P[whole] + frac * (P[whole + 1] - P[whole])).cast<float>());
+    if (npts > whole + 1)
+      out.points.push_back((P[whole] + frac * (P[whole + 1] - P[whole])).cast<float>());
     out.offsets.push_back(uint32_t(out.points.size()));
   }
 }

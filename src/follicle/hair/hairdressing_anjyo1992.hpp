@@ -51,9 +51,9 @@ struct NodeRange {
 /// `point`, normalized hull coordinates), "radial" (strength away from the hull centre).
 struct ForceField {
   std::string kind = "uniform";
-  Vec3 vector = Vec3::Zero();   // [m/s²] uniform field (world axes)
-  Vec3 point = Vec3::Zero();    // attract: target in normalized hull coordinates
-  double strength = 0.0;        // [m/s²] attract / radial
+  Vec3 vector = Vec3::Zero();  // [m/s²] uniform field (world axes)
+  Vec3 point = Vec3::Zero();   // attract: target in normalized hull coordinates
+  double strength = 0.0;       // [m/s²] attract / radial
   PolarRange pores;
   NodeRange nodes;
   template <class V>
@@ -98,10 +98,10 @@ struct CutRule {
 /// from there as a separately designed tail hanging from the tie under gravity.
 struct TieParams {
   bool enabled = false;
-  Vec3 point{0.0, 0.35, -1.0};        // tie position (normalized hull coordinates)
-  double radius = 0.012;              // [m] radius of the tail at the tie
+  Vec3 point{0.0, 0.35, -1.0};          // tie position (normalized hull coordinates)
+  double radius = 0.012;                // [m] radius of the tail at the tie
   Vec3 tail_direction{0.0, 0.2, -1.0};  // initial tail direction (world)
-  double surface_offset = 0.004;      // [m] combed hair lies this far outside the hull
+  double surface_offset = 0.004;        // [m] combed hair lies this far outside the hull
   template <class V>
   void visit(V&& v) {
     v("enabled", enabled, {"tie this part into a tail"});

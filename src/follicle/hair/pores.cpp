@@ -80,20 +80,23 @@ HairRoots sample_pores(const Context& ctx, const sim::Ellipsoid& hull,
     part.polar.resize(n);
     part.length.resize(n);
     part.region.assign(n, uint32_t(ri));
-    parallel_for(ctx, 0, n, [&](std::size_t i) {
-      Rng rng = Rng::stream(seed, (uint64_t(ri) << 40) + i);
-      double az = 0, ze = 0;
-      Vec3 q;
-      for (int tries = 0; tries < 1000; ++tries) {  // rejection: accept with dA/dΩ / max
-        q = sample_direction(rng, r, az, ze);
-        if (rng.uniform() * gmax <= hull.area_density(q)) break;
-      }
-      const Vec3 p = hull.from_normalized(q);
-      part.polar[i] = Vec2(az, ze);
-      part.direction[i] = hull.normal(p);
-      part.position[i] = scalp ? scalp(p).point : p;
-      part.length[i] = r.length * (1.0 + r.length_jitter * rng.uniform(-1.0, 1.0));
-    }, 64);
+    parallel_for(
+        ctx, 0, n,
+        [&](std::size_t i) {
+          Rng rng = Rng::stream(seed, (uint64_t(ri) << 40) + i);
+          double az = 0, ze = 0;
+          Vec3 q;
+          for (int tries = 0; tries < 1000; ++tries) {  // rejection: accept with dA/dΩ / max
+            q = sample_direction(rng, r, az, ze);
+            if (rng.uniform() * gmax <= hull.area_density(q)) break;
+          }
+          const Vec3 p = hull.from_normalized(q);
+          part.polar[i] = Vec2(az, ze);
+          part.direction[i] = hull.normal(p);
+          part.position[i] = scalp ? scalp(p).point : p;
+          part.length[i] = r.length * (1.0 + r.length_jitter * rng.uniform(-1.0, 1.0));
+        },
+        64);
     all.append(part);
   }
   return all;

@@ -26,7 +26,8 @@ struct PoreRegion {
 
   template <class V>
   void visit(V&& v) {
-    v("azimuth_min", azimuth_min, {"azimuth range start (0 = face, +pi/2 = left)", "rad", -kPi, kPi});
+    v("azimuth_min", azimuth_min,
+      {"azimuth range start (0 = face, +pi/2 = left)", "rad", -kPi, kPi});
     v("azimuth_max", azimuth_max, {"azimuth range end", "rad", -kPi, kPi});
     v("zenith_min", zenith_min, {"zenith range start (0 = crown)", "rad", 0.0, kPi});
     v("zenith_max", zenith_max, {"zenith range end", "rad", 0.0, kPi});

@@ -53,10 +53,10 @@ CutRule cut_below(double y, const PolarRange& pores = {}) {
 
 // Scalp pores without the face: the front hairline is higher than at the sides and back.
 std::vector<PoreRegion> scalp(double density, double length, double jitter) {
-  return {region(-kPi, kPi, 0.0, 0.95, density, length, jitter),      // crown and top
-          region(0.75, kPi, 0.95, 1.75, density, length, jitter),     // left side and back
-          region(-kPi, -0.75, 0.95, 1.75, density, length, jitter),   // right side and back
-          region(2.2, -2.2, 1.75, 2.15, density, length, jitter)};    // nape (wraps through pi)
+  return {region(-kPi, kPi, 0.0, 0.95, density, length, jitter),     // crown and top
+          region(0.75, kPi, 0.95, 1.75, density, length, jitter),    // left side and back
+          region(-kPi, -0.75, 0.95, 1.75, density, length, jitter),  // right side and back
+          region(2.2, -2.2, 1.75, 2.15, density, length, jitter)};   // nape (wraps through pi)
 }
 
 HairStyle bob(double ds) {
@@ -71,7 +71,7 @@ HairStyle bob(double ds) {
   // the right half to the right, slightly backwards.
   main.fields.push_back(uniform({9.0, 0.0, -2.0}, polar(0.0, kPi), 0.15));
   main.fields.push_back(uniform({-9.0, 0.0, -2.0}, polar(-kPi, 0.0), 0.15));
-  main.cuts.push_back(cut_below(-1.15));  // the bob line at the jaw
+  main.cuts.push_back(cut_below(-1.15));                  // the bob line at the jaw
   main.cuts.push_back(cut_below(0.3, polar(-0.9, 0.9)));  // hair falling over the face: bangs
   HairPart bangs;
   bangs.name = "bangs";
@@ -147,10 +147,13 @@ HairStyle short_cut(double ds) {
 
 }  // namespace
 
-std::vector<std::string> style_preset_names() { return {"bob", "swept_back", "ponytail", "short_cut"}; }
+std::vector<std::string> style_preset_names() {
+  return {"bob", "swept_back", "ponytail", "short_cut"};
+}
 
 HairStyle style_preset(std::string_view name, double density_scale) {
-  if (!(density_scale > 0)) fail("style preset: density_scale must be positive, got {}", density_scale);
+  if (!(density_scale > 0))
+    fail("style preset: density_scale must be positive, got {}", density_scale);
   if (name == "bob") return bob(density_scale);
   if (name == "swept_back") return swept_back(density_scale);
   if (name == "ponytail") return ponytail(density_scale);

@@ -176,7 +176,8 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
           const Vec2 h(dir.x(), dir.z()), hp(dirp.x(), dirp.z()), ah(a.x(), a.z());
           Vec2 hn = h + damp * (h - hp) + dt2 * G * ah;
           if (hn.norm() > 1.0) hn.normalize();
-          const double yv = (dir.y() >= 0 ? 1.0 : -1.0) * std::sqrt(std::max(0.0, 1.0 - hn.squaredNorm()));
+          const double yv =
+              (dir.y() >= 0 ? 1.0 : -1.0) * std::sqrt(std::max(0.0, 1.0 - hn.squaredNorm()));
           const Vec3 nd0(hn.x(), yv, hn.y());
           direction_angles(nd0, ph, thn, phn);
           direction_angles(dir, phn, th, ph);  // the current angles on the same branch
@@ -184,7 +185,7 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
           const double cth = std::cos(th), sph = std::sin(ph), cph = std::cos(ph);
           const double Fth = a.x() * cth * sph - a.y() * sth + a.z() * cth * cph;  // (F, V_θ)
           const double sgn = sth >= 0 ? 1.0 : -1.0;
-          const double Fph = sgn * (a.x() * cph - a.z() * sph);                   // (F, V_φ)
+          const double Fph = sgn * (a.x() * cph - a.z() * sph);  // (F, V_φ)
           // (4)' and (5)': u_i = |s_i|/2, v_i = |s_i| |sin θ| / 2 -> v_i / u_i = |sin θ|.
           thn = th + damp * (th - thp) + dt2 * G * Fth;
           phn = ph + damp * (ph - php) + dt2 * G * std::abs(sth) * Fph;
@@ -227,8 +228,10 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
         Vec3& node = st.nodes[i * N + s];
         const double v = (pnew - node).norm() / dt;
         node = pnew;
-        if (!std::isfinite(thn) || !std::isfinite(phn) || !pnew.allFinite()) rep.mark_non_finite(s);
-        else if (v > m_p.max_speed) rep.mark_blow_up(s);
+        if (!std::isfinite(thn) || !std::isfinite(phn) || !pnew.allFinite())
+          rep.mark_non_finite(s);
+        else if (v > m_p.max_speed)
+          rep.mark_blow_up(s);
         if (std::isfinite(v)) rep.max_speed = std::max(rep.max_speed, v);
       }
     }

@@ -22,47 +22,51 @@
 namespace follicle::hair {
 
 struct ProjectiveParams {
-  double dt = 1.0 / 60.0;            // Δt [s]
-  std::string inertia = "paper";     // "paper": c_i ∝ i, I_k = I_S (§3.2.1); "uniform": c_i equal
-  double inertia_scale = 1.0;        // multiplies every c_i
-  double top_inertia_scale = 1.0;    // c_i factor for segments starting above top_height (friction
-  double top_height = 0.6;           // near the top of the head, §3.2.1); normalized hull q_y
-  bool pseudo_force = true;          // §3.2.2
-  double alpha = -0.75;              // α: (D_i, F) < α |D_i| |F| means "against the head"
-  double epsilon = 0.1;              // ε_i of the segments near the head
-  double epsilon_extent = 1.0;       // ε applies to segments i <= extent * k (root side)
-  double near_head = 0.25;           // "near the head": |q| - 1 < near_head (normalized hull)
-  double stiffness_root_deg = 180.0; // σ_i of the first stiffness_root_segments joints [deg]
-  double stiffness_deg = 180.0;      // σ_i of the other joints [deg] (180 = no adjustment)
+  double dt = 1.0 / 60.0;          // Δt [s]
+  std::string inertia = "paper";   // "paper": c_i ∝ i, I_k = I_S (§3.2.1); "uniform": c_i equal
+  double inertia_scale = 1.0;      // multiplies every c_i
+  double top_inertia_scale = 1.0;  // c_i factor for segments starting above top_height (friction
+  double top_height = 0.6;         // near the top of the head, §3.2.1); normalized hull q_y
+  bool pseudo_force = true;        // §3.2.2
+  double alpha = -0.75;            // α: (D_i, F) < α |D_i| |F| means "against the head"
+  double epsilon = 0.1;            // ε_i of the segments near the head
+  double epsilon_extent = 1.0;     // ε applies to segments i <= extent * k (root side)
+  double near_head = 0.25;         // "near the head": |q| - 1 < near_head (normalized hull)
+  double stiffness_root_deg = 180.0;  // σ_i of the first stiffness_root_segments joints [deg]
+  double stiffness_deg = 180.0;       // σ_i of the other joints [deg] (180 = no adjustment)
   int stiffness_root_segments = 3;
-  double fluctuation = 0.0;          // [rad] amplitude of the uniform random angle fluctuation
-  int fluctuation_interval = 10;     // steps between fluctuations ("one per ten frames")
-  double damping = 0.0;              // [1/s] velocity damping (not in the paper; 0 = off)
-  double rest_spring = 0.0;          // [1/s²] pull towards the styled angles (not in the paper)
-  double parallel_threshold = 0.05;  // |sin θ| below which the θ plane is spanned by y and F
-  bool ellipsoid_constraint = false; // hard push-out of nodes from the hull (not in the paper)
-  double max_speed = 100.0;          // [m/s] blow-up limit reported in StepReport
+  double fluctuation = 0.0;           // [rad] amplitude of the uniform random angle fluctuation
+  int fluctuation_interval = 10;      // steps between fluctuations ("one per ten frames")
+  double damping = 0.0;               // [1/s] velocity damping (not in the paper; 0 = off)
+  double rest_spring = 0.0;           // [1/s²] pull towards the styled angles (not in the paper)
+  double parallel_threshold = 0.05;   // |sin θ| below which the θ plane is spanned by y and F
+  bool ellipsoid_constraint = false;  // hard push-out of nodes from the hull (not in the paper)
+  double max_speed = 100.0;           // [m/s] blow-up limit reported in StepReport
 
   template <class V>
   void visit(V&& v) {
     v("dt", dt, {"time step", "s", 1e-6, 1.0});
     v("inertia", inertia, {"paper | uniform"});
     v("inertia_scale", inertia_scale, {"multiplier of c_i", "", 0.0, 1e6});
-    v("top_inertia_scale", top_inertia_scale, {"c_i factor near the top of the head", "", 0.0, 1e3});
+    v("top_inertia_scale", top_inertia_scale,
+      {"c_i factor near the top of the head", "", 0.0, 1e3});
     v("top_height", top_height, {"q_y above which top_inertia_scale applies", "", -10.0, 10.0});
     v("pseudo_force", pseudo_force, {"use the pseudo-force field"});
     v("alpha", alpha, {"pseudo-force angle test", "", -1.0, 1.0});
     v("epsilon", epsilon, {"pseudo-force factor", "", 0.0, 1.0});
-    v("epsilon_extent", epsilon_extent, {"fraction of segments (root side) with epsilon", "", 0.0, 1.0});
+    v("epsilon_extent", epsilon_extent,
+      {"fraction of segments (root side) with epsilon", "", 0.0, 1.0});
     v("near_head", near_head, {"near-head band in normalized hull units", "", 0.0, 10.0});
     v("stiffness_root_deg", stiffness_root_deg, {"sigma near the pore", "deg", 0.0, 180.0});
     v("stiffness_deg", stiffness_deg, {"sigma elsewhere", "deg", 0.0, 180.0});
-    v("stiffness_root_segments", stiffness_root_segments, {"joints counted as near the pore", "", 0, 64});
+    v("stiffness_root_segments", stiffness_root_segments,
+      {"joints counted as near the pore", "", 0, 64});
     v("fluctuation", fluctuation, {"random angle fluctuation", "rad", 0.0, 1.0});
     v("fluctuation_interval", fluctuation_interval, {"steps between fluctuations", "", 1, 100000});
     v("damping", damping, {"angular velocity damping", "1/s", 0.0, 1e4});
     v("rest_spring", rest_spring, {"pull towards the styled shape", "1/s^2", 0.0, 1e6});
-    v("parallel_threshold", parallel_threshold, {"|sin theta| of a segment parallel to y", "", 0.0, 0.5});
+    v("parallel_threshold", parallel_threshold,
+      {"|sin theta| of a segment parallel to y", "", 0.0, 0.5});
     v("ellipsoid_constraint", ellipsoid_constraint, {"push nodes out of the hull"});
     v("max_speed", max_speed, {"blow-up speed", "m/s", 1e-3, 1e6});
   }

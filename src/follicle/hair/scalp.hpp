@@ -16,8 +16,8 @@ class MeshQuery;
 namespace follicle::hair {
 
 struct SurfaceHit {
-  Vec3 point = Vec3::Zero();   // closest point on the surface [m]
-  Vec3 normal = Vec3::UnitY(); // outward unit normal (of the face holding `point`)
+  Vec3 point = Vec3::Zero();    // closest point on the surface [m]
+  Vec3 normal = Vec3::UnitY();  // outward unit normal (of the face holding `point`)
 };
 
 /// Closest point on a surface to a query point. Must be thread-safe (called from parallel loops).

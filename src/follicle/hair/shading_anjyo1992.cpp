@@ -9,7 +9,9 @@
 
 namespace follicle::hair {
 
-void AnjyoShadingParams::validate() const { validate_params(*this, "anjyo_shading"); }
+void AnjyoShadingParams::validate() const {
+  validate_params(*this, "anjyo_shading");
+}
 
 double anjyo_specular(const Vec3& T, const Vec3& H, double ks, double n) {
   const double th = T.dot(H);
@@ -23,26 +25,31 @@ void shade_anjyo1992(const Context& ctx, geom::StrandSet& strands, const AnjyoSh
   p.validate();
   strands.color.resize(strands.points.size());
   const Vec3 L = to_light.normalized();
-  parallel_for(ctx, 0, strands.num_strands(), [&](std::size_t s) {
-    Rng rng = Rng::stream(seed, s);
-    const double ka = std::max(0.0, rng.normal(p.ka_mean, p.ka_sigma));
-    const uint32_t b = strands.offsets[s], e = strands.offsets[s + 1];
-    for (uint32_t i = b; i < e; ++i) {
-      Vec3 T = Vec3::UnitY();
-      if (e - b >= 2) {
-        const uint32_t j = i == b ? b + 1 : i;
-        const Vec3 t = (strands.points[j] - strands.points[j - 1]).cast<double>();
-        if (t.norm() > 0) T = t.normalized();
-      }
-      const Vec3 P = strands.points[i].cast<double>();
-      const Vec3 V = (eye - P).normalized();
-      const Vec3 H = (L + V).normalized();
-      const double phi = anjyo_specular(T, H, p.ks, p.exponent);
-      // (9) I = Ia ka + Is Φs, coloured: ambient with the hair colour, highlight with the light's.
-      const Vec3 c = p.ambient_intensity * ka * p.hair_color + p.light_intensity * phi * p.specular_color;
-      strands.color[i] = c.cwiseMax(0.0).cwiseMin(1.0).cast<float>();
-    }
-  }, 256);
+  parallel_for(
+      ctx, 0, strands.num_strands(),
+      [&](std::size_t s) {
+        Rng rng = Rng::stream(seed, s);
+        const double ka = std::max(0.0, rng.normal(p.ka_mean, p.ka_sigma));
+        const uint32_t b = strands.offsets[s], e = strands.offsets[s + 1];
+        for (uint32_t i = b; i < e; ++i) {
+          Vec3 T = Vec3::UnitY();
+          if (e - b >= 2) {
+            const uint32_t j = i == b ? b + 1 : i;
+            const Vec3 t = (strands.points[j] - strands.points[j - 1]).cast<double>();
+            if (t.norm() > 0) T = t.normalized();
+          }
+          const Vec3 P = strands.points[i].cast<double>();
+          const Vec3 V = (eye - P).normalized();
+          const Vec3 H = (L + V).normalized();
+          const double phi = anjyo_specular(T, H, p.ks, p.exponent);
+          // (9) I = Ia ka + Is Φs, coloured: ambient with the hair colour, highlight with the
+          // light's.
+          const Vec3 c =
+              p.ambient_intensity * ka * p.hair_color + p.light_intensity * phi * p.specular_color;
+          strands.color[i] = c.cwiseMax(0.0).cwiseMin(1.0).cast<float>();
+        }
+      },
+      256);
 }
 
 }  // namespace follicle::hair

@@ -13,14 +13,14 @@
 namespace follicle::hair {
 
 struct AnjyoShadingParams {
-  Vec3 hair_color{0.16, 0.09, 0.05};   // linear RGB albedo multiplying the ambient term
+  Vec3 hair_color{0.16, 0.09, 0.05};     // linear RGB albedo multiplying the ambient term
   Vec3 specular_color{1.0, 0.95, 0.85};  // linear RGB of the highlight
-  double ambient_intensity = 1.0;      // Ia
-  double ka_mean = 0.8;                // mean of the per-strand ambient coefficient ka
-  double ka_sigma = 0.15;              // standard deviation of ka (normal distribution)
-  double ks = 0.25;                    // specular coefficient
-  double exponent = 120.0;             // n, sharpness of the highlight
-  double light_intensity = 1.0;        // Is
+  double ambient_intensity = 1.0;        // Ia
+  double ka_mean = 0.8;                  // mean of the per-strand ambient coefficient ka
+  double ka_sigma = 0.15;                // standard deviation of ka (normal distribution)
+  double ks = 0.25;                      // specular coefficient
+  double exponent = 120.0;               // n, sharpness of the highlight
+  double light_intensity = 1.0;          // Is
   template <class V>
   void visit(V&& v) {
     v("hair_color", hair_color, {"ambient hair colour (linear RGB)", "", 0.0, 1.0});

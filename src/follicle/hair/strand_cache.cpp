@@ -43,7 +43,8 @@ StrandFrame parse_strand_frame(const std::string& b, const std::string& where) {
   std::size_t pos = 0;
   auto need = [&](std::size_t n, const char* what) {
     if (n > b.size() || pos > b.size() - n)
-      fail_at(where, "strand cache is truncated: expected {} bytes of {} at offset {}", n, what, pos);
+      fail_at(where, "strand cache is truncated: expected {} bytes of {} at offset {}", n, what,
+              pos);
   };
   auto get = [&](auto& v, const char* what) {
     need(sizeof(v), what);
@@ -51,12 +52,14 @@ StrandFrame parse_strand_frame(const std::string& b, const std::string& where) {
     pos += sizeof(v);
   };
   need(8, "magic");
-  if (std::memcmp(b.data(), kMagic, 8) != 0) fail_at(where, "not a Follicle strand cache (bad magic)");
+  if (std::memcmp(b.data(), kMagic, 8) != 0)
+    fail_at(where, "not a Follicle strand cache (bad magic)");
   pos = 8;
   uint32_t version = 0, flags = 0;
   get(version, "version");
   if (version != kStrandCacheVersion)
-    fail_at(where, "strand cache version {} is not supported (expected {})", version, kStrandCacheVersion);
+    fail_at(where, "strand cache version {} is not supported (expected {})", version,
+            kStrandCacheVersion);
   get(flags, "flags");
   StrandFrame f;
   get(f.frame, "frame");
@@ -89,7 +92,8 @@ StrandFrame parse_strand_frame(const std::string& b, const std::string& where) {
   if (s.offsets.front() != 0 || s.offsets.back() != np)
     fail_at(where, "strand cache offsets do not cover the {} points", np);
   for (std::size_t i = 1; i < s.offsets.size(); ++i)
-    if (s.offsets[i] < s.offsets[i - 1]) fail_at(where, "strand cache offsets decrease at strand {}", i - 1);
+    if (s.offsets[i] < s.offsets[i - 1])
+      fail_at(where, "strand cache offsets decrease at strand {}", i - 1);
   return f;
 }
 

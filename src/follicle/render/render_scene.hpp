@@ -110,13 +110,70 @@ enum class ParticleShading {
   HairSplat,  // textured billboards aligned with the particle direction (Bando 2003 §3.4)
 };
 
+/// Hair splatting parameters (Bando 2003 §3.4; formulas in docs/equations/splat.md). Used by
+/// ParticleShading::HairSplat: every particle is a billboard 2*width_scale*r wide across and
+/// 2*length_scale*r long along its direction t_i (r = its radius), textured with a hair texture
+/// whose vertical axis follows t_i, of opacity min(1, alpha / max(sin(theta), min_sin_theta))
+/// where cos(theta) = t_i . d_p, and shaded by the Kajiya-Kay phase function times Goldman's
+/// directionality factor f_dir = (1+kappa)/2 reflect + (1-kappa)/2 transmit.
+struct SplatMaterial {
+  double diffuse = 0.8;         // Kajiya-Kay K_d
+  double specular = 0.25;       // Kajiya-Kay K_s
+  double shininess = 30.0;      // Kajiya-Kay exponent p
+  double ambient = 0.12;        // ambient factor (times RenderScene::ambient_color)
+  double reflect = 1.0;         // Goldman rho_reflect (eye on the lit side, kappa = +1)
+  double transmit = 0.35;       // Goldman rho_transmit (back-lit, kappa = -1)
+  double length_scale = 3.0;    // billboard half-length along t_i, in particle radii
+  double width_scale = 1.0;     // billboard half-width across t_i, in particle radii
+  double min_sin_theta = 0.25;  // clamp of sin(theta) in the 1/sin(theta) opacity rule
+  double shadow_opacity_scale = 1.0;  // opacity multiplier in the light-view pass
+  bool self_shadow = true;  // particles read the light attenuated by the hair nearer the light
+  bool cast_shadow = true;  // particles attenuate light for other particles and for the meshes
+
+  template <class V>
+  void visit(V&& v) {
+    v("diffuse", diffuse, ParamInfo{"Kajiya-Kay diffuse coefficient K_d", "", 0, 10});
+    v("specular", specular, ParamInfo{"Kajiya-Kay specular coefficient K_s", "", 0, 10});
+    v("shininess", shininess, ParamInfo{"Kajiya-Kay specular exponent", "", 0, 10000});
+    v("ambient", ambient, ParamInfo{"ambient factor", "", 0, 10});
+    v("reflect", reflect, ParamInfo{"Goldman directionality: reflection factor", "", 0, 10});
+    v("transmit", transmit, ParamInfo{"Goldman directionality: transmission factor", "", 0, 10});
+    v("length_scale", length_scale,
+      ParamInfo{"billboard half-length along the hair direction", "radii", 1e-3, 1e3});
+    v("width_scale", width_scale,
+      ParamInfo{"billboard half-width across the hair direction", "radii", 1e-3, 1e3});
+    v("min_sin_theta", min_sin_theta,
+      ParamInfo{"lower clamp of sin(theta) in the 1/sin(theta) opacity rule", "", 1e-3, 1});
+    v("shadow_opacity_scale", shadow_opacity_scale,
+      ParamInfo{"opacity multiplier in the light-view (shadow) pass", "", 0, 100});
+    v("self_shadow", self_shadow, ParamInfo{"hair shadows itself", ""});
+    v("cast_shadow", cast_shadow, ParamInfo{"hair casts shadows on hair and meshes", ""});
+  }
+  void validate() const { validate_params(*this, "splat"); }
+};
+
 struct ParticleItem {
   std::shared_ptr<const geom::ParticleSet> particles;
   Affine3 transform = Affine3::Identity();
   ParticleShading shading = ParticleShading::Flat;
-  Vec3 color{0.3, 0.2, 0.1};
-  double radius = 0.002;  // [m] when the set has no radii
-  double opacity = 1.0;
+  Vec3 color{0.3, 0.2, 0.1};  // linear RGB when the set has no colours (the hair colour)
+  double radius = 0.002;      // [m] when the set has no radii
+  double opacity = 1.0;       // times the per-particle opacity of the set
+  SplatMaterial splat;        // for HairSplat
+  /// For HairSplat: RGB = brightness factor (linear), A = coverage; the hair runs along the
+  /// image's vertical axis. Null: the procedural make_hair_texture(). HairSplat items drawn
+  /// together must use the same texture (or null).
+  std::shared_ptr<const image::ImageRGBA8> hair_texture;
+
+  template <class V>
+  void visit(V&& v) {
+    v("color", color, ParamInfo{"colour when the particles have none", "", 0, 1000});
+    v("radius", radius, ParamInfo{"radius when the particles have none", "m", 0, 1e6});
+    v("opacity", opacity, ParamInfo{"opacity multiplier", "", 0, 1});
+    v("splat", splat);
+  }
+  /// Checks the parameters (not the particle data; the renderer checks that, naming the item).
+  void validate() const { validate_params(*this, "particles"); }
 };
 
 struct RenderScene {
@@ -135,6 +192,12 @@ struct RenderSettings {
   int supersample = 2;  // render at (supersample * size) and box-filter down
   int shadow_map_size = 2048;
   bool transparent_background = false;  // background alpha 0 instead of 1 (output alpha = coverage)
+  int hair_light_map_size = 512;  // light-view buffer of the hair splat pass (Bando 2003 §3.4)
+  /// Depth slices of the hair light-view pass: particles are sorted by depth from the light and
+  /// cut into this many equal batches; each batch reads the light reaching it, then is splatted
+  /// (docs/adr/0003-splat-light-pass.md). >= the particle count reproduces the paper's
+  /// per-particle read exactly.
+  int hair_light_slices = 128;
 
   template <class V>
   void visit(V&& v) {
@@ -143,6 +206,10 @@ struct RenderSettings {
     v("supersample", supersample, ParamInfo{"supersampling factor per axis", "", 1, 8});
     v("shadow_map_size", shadow_map_size, ParamInfo{"shadow map resolution", "px", 16, 16384});
     v("transparent_background", transparent_background, ParamInfo{"background alpha 0", ""});
+    v("hair_light_map_size", hair_light_map_size,
+      ParamInfo{"hair light-view buffer resolution", "px", 16, 16384});
+    v("hair_light_slices", hair_light_slices,
+      ParamInfo{"depth slices of the hair light-view pass", "", 1, 1 << 24});
   }
   void validate() const { validate_params(*this, "render"); }
 };

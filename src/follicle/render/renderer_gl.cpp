@@ -14,8 +14,10 @@
 
 #include "follicle/render/camera.hpp"
 #include "follicle/render/egl_context.hpp"
+#include "follicle/render/gl_util.hpp"
 #include "follicle/render/renderer.hpp"
 #include "follicle/render/shaders_gl.hpp"
+#include "follicle/render/splat_gl.hpp"
 
 namespace follicle::render {
 namespace {
@@ -23,69 +25,7 @@ namespace {
 constexpr int kMaxLights = 8;
 constexpr int kMaxLobes = 4;
 
-GLuint compile(GLenum type, const std::string& src, const char* name) {
-  GLuint s = glCreateShader(type);
-  const char* p = src.c_str();
-  glShaderSource(s, 1, &p, nullptr);
-  glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {0};
-    glGetShaderInfoLog(s, sizeof(log) - 1, nullptr, log);
-    glDeleteShader(s);
-    fail("render: cannot compile shader {}: {}", name, log);
-  }
-  return s;
-}
-
-GLuint link_program(const char* name, const std::string& defines, const char* vs, const char* fs,
-                    const char* gs = nullptr, bool lights = false) {
-  const std::string head = std::string("#version 330 core\n") + defines;
-  const std::string lb = lights ? glsl::kLightsBlock : "";
-  GLuint v = compile(GL_VERTEX_SHADER, head + vs, name);
-  GLuint f = compile(GL_FRAGMENT_SHADER, head + lb + fs, name);
-  GLuint g = gs ? compile(GL_GEOMETRY_SHADER, head + gs, name) : 0;
-  GLuint p = glCreateProgram();
-  glAttachShader(p, v);
-  glAttachShader(p, f);
-  if (g) glAttachShader(p, g);
-  glLinkProgram(p);
-  glDeleteShader(v);
-  glDeleteShader(f);
-  if (g) glDeleteShader(g);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {0};
-    glGetProgramInfoLog(p, sizeof(log) - 1, nullptr, log);
-    glDeleteProgram(p);
-    fail("render: cannot link shader program {}: {}", name, log);
-  }
-  return p;
-}
-
-Eigen::Matrix4f to_f(const Mat4& m) {
-  return m.cast<float>();
-}
-
-void set_mat4(GLuint p, const char* n, const Mat4& m) {
-  const Eigen::Matrix4f f = to_f(m);  // Eigen is column-major like GL
-  glUniformMatrix4fv(glGetUniformLocation(p, n), 1, GL_FALSE, f.data());
-}
-void set_mat3(GLuint p, const char* n, const Mat3& m) {
-  const Eigen::Matrix3f f = m.cast<float>();
-  glUniformMatrix3fv(glGetUniformLocation(p, n), 1, GL_FALSE, f.data());
-}
-void set_vec3(GLuint p, const char* n, const Vec3& v) {
-  glUniform3f(glGetUniformLocation(p, n), float(v.x()), float(v.y()), float(v.z()));
-}
-void set_f(GLuint p, const char* n, double v) {
-  glUniform1f(glGetUniformLocation(p, n), float(v));
-}
-void set_i(GLuint p, const char* n, int v) {
-  glUniform1i(glGetUniformLocation(p, n), v);
-}
+using namespace gl;
 
 /// GL objects created for one render() and deleted at its end.
 struct FrameObjects {
@@ -266,6 +206,7 @@ class GlRenderer final : public Renderer {
   ~GlRenderer() override {
     try {
       if (m_egl) m_egl->make_current();
+      m_splat.reset();
       for (GLuint p : {m_line_prog, m_ribbon_prog, m_depth_prog, m_particle_prog, m_resolve_prog})
         glDeleteProgram(p);
       for (auto& [key, p] : m_mesh_progs) glDeleteProgram(p);
@@ -331,6 +272,7 @@ class GlRenderer final : public Renderer {
     m_depth_prog = link_program("depth", "", glsl::kDepthVs, glsl::kDepthFs);
     m_particle_prog = link_program("particles", "", glsl::kParticleVs, glsl::kParticleFs);
     m_resolve_prog = link_program("resolve", "", glsl::kResolveVs, glsl::kResolveFs);
+    m_splat = std::make_unique<SplatPassGl>();
     glGenVertexArrays(1, &m_empty_vao);
     const float quad[] = {-1, -1, 1, -1, -1, 1, 1, 1};
     glGenBuffers(1, &m_quad_vbo);
@@ -541,9 +483,11 @@ class GlRenderer final : public Renderer {
     const Mat4 proj = projection_matrix(scene.camera, double(settings.width) / settings.height);
     const Mat4 view_proj = proj * view;
     std::vector<ParticleDraw> particles;
+    m_splat->prepare(scene, sb);  // the HairSplat items (Bando 2003 §3.4)
     for (std::size_t i = 0; i < scene.particles.size(); ++i) {
       const ParticleItem& item = scene.particles[i];
       if (!item.particles || item.particles->positions.empty()) continue;
+      if (item.shading == ParticleShading::HairSplat) continue;
       particles.push_back(upload_particles(fo, item, i, view));
     }
     check_gl("upload");
@@ -589,6 +533,16 @@ class GlRenderer final : public Renderer {
         glMultiDrawArrays(GL_LINE_STRIP, d.first.data(), d.count.data(), GLsizei(d.first.size()));
       }
       check_gl("shadow pass");
+      if (!m_splat->empty()) {
+        SplatPassGl::Light sl;
+        sl.index = shadow_light;
+        sl.travel = dir;
+        sl.light_vp = light_vp;
+        sl.shadow_tex = m_shadow_tex;
+        sl.shadow_texel = 1.0 / settings.shadow_map_size;
+        sl.shadow_bias = 2.0 * shadow_texel_world / shadow_depth_range;
+        m_splat->light_pass(sl, settings, m_empty_vao);
+      }
     }
 
     // ---- main pass ----------------------------------------------------------------------------
@@ -610,6 +564,7 @@ class GlRenderer final : public Renderer {
       st.shadow_texel = 1.0 / settings.shadow_map_size;
       st.shadow_normal_offset = 1.5 * shadow_texel_world;
       st.shadow_bias = 1.0 * shadow_texel_world / shadow_depth_range;
+      st.light_map = shadows ? m_splat->light_map() : 0;
       for (const MeshDraw& d : meshes) draw_mesh(st, d);
       check_gl("mesh pass");
     }
@@ -636,6 +591,7 @@ class GlRenderer final : public Renderer {
       }
       check_gl("particle pass");
     }
+    if (!m_splat->empty()) m_splat->view_pass(scene, view, view_proj, m_empty_vao);
 
     // ---- resolve ------------------------------------------------------------------------------
     glDisable(GL_DEPTH_TEST);
@@ -659,9 +615,10 @@ class GlRenderer final : public Renderer {
     Mat4 view_proj, light_vp;
     int shadow_light = -1;
     double shadow_texel = 0, shadow_normal_offset = 0, shadow_bias = 0;
+    GLuint light_map = 0;  // hair light map (Bando 2003 §3.4), 0: none
   };
 
-  enum MeshFeature { kAlbedo = 4, kHeight = 8, kNormalMap = 16, kShadow = 32 };
+  enum MeshFeature { kAlbedo = 4, kHeight = 8, kNormalMap = 16, kShadow = 32, kLightMap = 64 };
 
   /// Mesh program variant: bits 0-1 shading (0 Blinn-Phong, 1 Lafortune, 2 unlit), then
   /// MeshFeature bits. Compiled on first use and kept.
@@ -673,6 +630,7 @@ class GlRenderer final : public Renderer {
     if (key & kHeight) defs += "#define HAS_HEIGHT\n";
     if (key & kNormalMap) defs += "#define HAS_NORMALMAP\n";
     if (key & kShadow) defs += "#define HAS_SHADOW\n";
+    if (key & kLightMap) defs += "#define HAS_LIGHTMAP\n";
     const GLuint p = link_program("mesh", defs, glsl::kMeshVs, glsl::kMeshFs, nullptr, true);
     m_mesh_progs[key] = p;
     return p;
@@ -688,8 +646,9 @@ class GlRenderer final : public Renderer {
     const bool height = mat.height_map && d.has_uvs && shading != 2;
     const bool nmap = mat.normal_map && d.has_uvs && shading != 2;
     const bool shadow = st.shadow_light >= 0 && shading != 2;
+    const bool lmap = shadow && st.light_map != 0;
     const int key = shading | (albedo ? kAlbedo : 0) | (height ? kHeight : 0) |
-                    (nmap ? kNormalMap : 0) | (shadow ? kShadow : 0);
+                    (nmap ? kNormalMap : 0) | (shadow ? kShadow : 0) | (lmap ? kLightMap : 0);
     const GLuint p = mesh_program(key);
     glUseProgram(p);
     set_mat4(p, "uViewProj", st.view_proj);
@@ -705,6 +664,11 @@ class GlRenderer final : public Renderer {
       set_f(p, "uShadowTexel", st.shadow_texel);
       set_f(p, "uShadowNormalOffset", st.shadow_normal_offset);
       set_f(p, "uShadowBias", st.shadow_bias);
+    }
+    if (lmap) {
+      set_i(p, "uLightMap", 4);
+      glActiveTexture(GL_TEXTURE4);
+      glBindTexture(GL_TEXTURE_2D, st.light_map);
     }
     // Albedo: per-vertex colours, else the base colour (rho_d for Lafortune), times the
     // texture when there is one (the texture alone when there are no vertex colours).
@@ -911,6 +875,7 @@ class GlRenderer final : public Renderer {
   int m_fb_w = 0, m_fb_h = 0, m_out_w = 0, m_out_h = 0, m_shadow_size = 0;
   float m_line_width_range[2] = {1, 1};
   std::map<const void*, TexEntry> m_tex_cache;
+  std::unique_ptr<SplatPassGl> m_splat;
 };
 
 }  // namespace

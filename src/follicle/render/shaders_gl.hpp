@@ -42,7 +42,7 @@ void main() {
 )";
 
 // Features are compile-time (#define SHADING 0|1|2, HAS_ALBEDO, HAS_HEIGHT, HAS_NORMALMAP,
-// HAS_SHADOW): llvmpipe runs both sides of data-dependent branches, so texture fetches behind
+// HAS_SHADOW, HAS_LIGHTMAP): llvmpipe runs both sides of data-dependent branches, so texture fetches behind
 // a run-time flag would cost as much as taken ones.
 inline constexpr const char* kMeshFs = R"(
 in vec3 vPos;
@@ -72,6 +72,16 @@ uniform int uNumLobes;
 uniform vec3 uCxy[4];
 uniform vec3 uCz[4];
 uniform vec3 uN[4];
+
+#ifdef HAS_LIGHTMAP
+uniform sampler2D uLightMap;  // light through the hair (Bando 2003 §3.4, line 12), uLightVP
+float light_map(vec3 p) {
+  vec4 c = uLightVP * vec4(p, 1.0);
+  vec2 s = c.xy / c.w * 0.5 + 0.5;
+  if (s.x < 0.0 || s.x > 1.0 || s.y < 0.0 || s.y > 1.0) return 1.0;
+  return texture(uLightMap, s).r;
+}
+#endif
 
 #ifdef HAS_SHADOW
 float shadow_factor(vec3 p, vec3 ng) {
@@ -132,6 +142,9 @@ void main() {
   vec3 col = albedo * uAmbient * uAmbientColor;
 #ifdef HAS_SHADOW
   float shadow = shadow_factor(vPos, ng);
+#ifdef HAS_LIGHTMAP
+  shadow *= light_map(vPos);  // line 16: shadow and light mapping
+#endif
 #endif
   for (int i = 0; i < uNumLights; ++i) {
     vec3 L = uLightDir[i];

@@ -105,8 +105,8 @@ std::string suggest(const std::string& key, const std::vector<std::string>& know
   // plain edit distance prefers another key ("far"); then fall back to the edit distance.
   std::string best;
   for (const auto& k : known) {
-    const bool prefix = (key.size() >= 2 && k.rfind(key, 0) == 0) ||
-                        (k.size() >= 3 && key.rfind(k, 0) == 0);
+    const bool prefix =
+        (key.size() >= 2 && k.rfind(key, 0) == 0) || (k.size() >= 3 && key.rfind(k, 0) == 0);
     if (prefix && (best.empty() || edit_distance(key, k) < edit_distance(key, best))) best = k;
   }
   return best.empty() ? did_you_mean(key, known) : best;
@@ -166,8 +166,7 @@ std::string doc_default(const Json& j) {
   if (j.is_string() && j.get<std::string>().empty()) return "\"\"";
   if (j.is_array() && j.empty()) return "`[]`";
   if (j.is_object() && j.empty()) return "`{}`";
-  if (j.is_array() && !j.empty() && j[0].is_object())
-    return fmt::format("{} entries", j.size());
+  if (j.is_array() && !j.empty() && j[0].is_object()) return fmt::format("{} entries", j.size());
   Json r = j;
   // Round floats for the table (0.30000000000000004 -> 0.3).
   std::function<void(Json&)> round = [&](Json& x) {
@@ -188,12 +187,15 @@ std::string doc_table(const std::vector<DocRow>& rows) {
   auto esc = [](std::string s) {
     std::string out;
     for (char c : s) {
-      if (c == '|') out += "\\|";
-      else out += c;
+      if (c == '|')
+        out += "\\|";
+      else
+        out += c;
     }
     return out;
   };
-  std::string out = "| key | type | unit | default | range | meaning |\n|---|---|---|---|---|---|\n";
+  std::string out =
+      "| key | type | unit | default | range | meaning |\n|---|---|---|---|---|---|\n";
   for (const auto& r : rows) {
     out += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", r.key, esc(r.type), esc(r.unit),
                        esc(r.default_value), esc(r.range), esc(r.doc));

@@ -15,13 +15,12 @@
 //
 // A struct lists its required keys as `static constexpr const char* kRequired[] = {"path"};`.
 // Keys starting with "//" are comments and are ignored everywhere.
-#include <nlohmann/json.hpp>
-
 #include <array>
 #include <cmath>
-#include <limits>
 #include <filesystem>
+#include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -36,7 +35,9 @@
 namespace follicle {
 // Names for core's LengthUnit, found by ADL from the reader.
 inline constexpr std::array<std::pair<LengthUnit, const char*>, 4> follicle_enum_names(LengthUnit) {
-  return {{{LengthUnit::mm, "mm"}, {LengthUnit::cm, "cm"}, {LengthUnit::dm, "dm"},
+  return {{{LengthUnit::mm, "mm"},
+           {LengthUnit::cm, "cm"},
+           {LengthUnit::dm, "dm"},
            {LengthUnit::m, "m"}}};
 }
 }  // namespace follicle
@@ -61,14 +62,17 @@ std::string describe_json(const Json& j);
 std::string join_path(const std::string& path, const std::string& key);
 std::string index_path(const std::string& path, std::size_t i);
 /// Throws follicle::Error("<file>: <path>", what).
-[[noreturn]] void json_fail(const JsonSource& src, const std::string& path, const std::string& what);
+[[noreturn]] void json_fail(const JsonSource& src, const std::string& path,
+                            const std::string& what);
 /// The most plausible intended name for a mistyped `key` ("" when nothing is close).
 std::string suggest(const std::string& key, const std::vector<std::string>& known);
 /// Throws the unknown-key error with a did-you-mean and the list of accepted keys.
 [[noreturn]] void json_fail_unknown_key(const JsonSource& src, const std::string& path,
                                         const std::string& key,
                                         const std::vector<std::string>& known);
-inline bool is_comment_key(const std::string& k) { return k.size() >= 2 && k[0] == '/' && k[1] == '/'; }
+inline bool is_comment_key(const std::string& k) {
+  return k.size() >= 2 && k[0] == '/' && k[1] == '/';
+}
 
 namespace detail {
 
@@ -90,11 +94,15 @@ template <class S, int N, int O, int MR, int MC>
 struct is_eigen_vec<Eigen::Matrix<S, N, 1, O, MR, MC>> : std::bool_constant<(N > 0)> {};
 
 template <class E>
-concept NamedEnum = std::is_enum_v<E> && requires(E e) { follicle_enum_names(e); };
+concept NamedEnum = std::is_enum_v<E> && requires(E e) {
+  follicle_enum_names(e);
+};
 
 template <class T>
 concept Visitable = std::is_class_v<T> && !std::is_base_of_v<Eigen::EigenBase<T>, T> &&
-                    !std::is_same_v<T, std::string> && requires(T& t, ParamValidator& v) { t.visit(v); };
+                    !std::is_same_v<T, std::string> && requires(T & t, ParamValidator& v) {
+  t.visit(v);
+};
 
 template <class T>
 struct vector_of_visitable : std::false_type {};
@@ -106,7 +114,9 @@ template <class T, class C, class A>
 struct map_of_visitable<std::map<std::string, T, C, A>> : std::bool_constant<Visitable<T>> {};
 
 template <class T>
-concept HasRequired = requires { T::kRequired; };
+concept HasRequired = requires {
+  T::kRequired;
+};
 
 template <NamedEnum E>
 std::vector<std::string> enum_name_list() {
@@ -166,8 +176,7 @@ void read_json(const Json& j, const std::string& path, T& out, const JsonSource&
     if (!j.is_boolean()) json_fail(src, path, "expected true or false, got " + describe_json(j));
     out = j.get<bool>();
   } else if constexpr (std::is_integral_v<T>) {
-    if (!j.is_number())
-      json_fail(src, path, "expected an integer, got " + describe_json(j));
+    if (!j.is_number()) json_fail(src, path, "expected an integer, got " + describe_json(j));
     const double d = j.get<double>();
     if (j.is_number_float() && (d != std::floor(d) || !std::isfinite(d)))
       json_fail(src, path, "expected an integer, got " + describe_json(j));
@@ -196,15 +205,16 @@ void read_json(const Json& j, const std::string& path, T& out, const JsonSource&
     }
     const std::string hint = suggest(s, names);
     json_fail(src, path,
-              "unknown value \"" + s + "\"" + (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
-                  "; expected one of " + quoted_list(names));
+              "unknown value \"" + s + "\"" +
+                  (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") + "; expected one of " +
+                  quoted_list(names));
   } else if constexpr (is_eigen_vec<T>::value) {
     constexpr int n = T::RowsAtCompileTime;
     if (!j.is_array() || j.size() != std::size_t(n))
       json_fail(src, path,
                 "expected an array of " + std::to_string(n) + " numbers, got " + describe_json(j));
-    for (int i = 0; i < n; ++i) read_json(j[std::size_t(i)], index_path(path, std::size_t(i)),
-                                          out[i], src, info);
+    for (int i = 0; i < n; ++i)
+      read_json(j[std::size_t(i)], index_path(path, std::size_t(i)), out[i], src, info);
   } else if constexpr (is_optional<T>::value) {
     typename T::value_type v{};
     if (out) v = *out;
@@ -214,7 +224,8 @@ void read_json(const Json& j, const std::string& path, T& out, const JsonSource&
     if (!j.is_array()) json_fail(src, path, "expected an array, got " + describe_json(j));
     T result;
     result.resize(j.size());
-    for (std::size_t i = 0; i < j.size(); ++i) read_json(j[i], index_path(path, i), result[i], src, info);
+    for (std::size_t i = 0; i < j.size(); ++i)
+      read_json(j[i], index_path(path, i), result[i], src, info);
     out = std::move(result);
   } else if constexpr (is_map<T>::value) {
     if (!j.is_object()) json_fail(src, path, "expected an object, got " + describe_json(j));
@@ -307,22 +318,33 @@ namespace detail {
 
 template <class T>
 std::string doc_type_name() {
-  if constexpr (std::is_same_v<T, bool>) return "boolean";
-  else if constexpr (std::is_integral_v<T>) return "integer";
-  else if constexpr (std::is_floating_point_v<T>) return "number";
-  else if constexpr (std::is_same_v<T, std::string>) return "string";
-  else if constexpr (NamedEnum<T>) return "one of " + quoted_list(enum_name_list<T>());
+  if constexpr (std::is_same_v<T, bool>)
+    return "boolean";
+  else if constexpr (std::is_integral_v<T>)
+    return "integer";
+  else if constexpr (std::is_floating_point_v<T>)
+    return "number";
+  else if constexpr (std::is_same_v<T, std::string>)
+    return "string";
+  else if constexpr (NamedEnum<T>)
+    return "one of " + quoted_list(enum_name_list<T>());
   else if constexpr (is_eigen_vec<T>::value)
     return "array of " + std::to_string(T::RowsAtCompileTime) +
            (std::is_integral_v<typename T::Scalar> ? " integers" : " numbers");
-  else if constexpr (is_optional<T>::value) return doc_type_name<typename T::value_type>();
+  else if constexpr (is_optional<T>::value)
+    return doc_type_name<typename T::value_type>();
   else if constexpr (is_vector<T>::value) {
     using E = typename T::value_type;
-    if constexpr (Visitable<E>) return "array of objects";
-    else return "array of " + doc_type_name<E>();
-  } else if constexpr (is_map<T>::value) return "object (name → value)";
-  else if constexpr (Visitable<T>) return "object";
-  else static_assert(sizeof(T) == 0, "doc: unsupported field type");
+    if constexpr (Visitable<E>)
+      return "array of objects";
+    else
+      return "array of " + doc_type_name<E>();
+  } else if constexpr (is_map<T>::value)
+    return "object (name → value)";
+  else if constexpr (Visitable<T>)
+    return "object";
+  else
+    static_assert(sizeof(T) == 0, "doc: unsupported field type");
 }
 
 std::string doc_range(const ParamInfo& info, bool numeric);

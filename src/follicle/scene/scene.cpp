@@ -56,7 +56,8 @@ void Scene::validate(const JsonSource& src) const {
 
 Scene read_scene(const Json& j, const JsonSource& src) {
   if (!j.is_object())
-    json_fail(src, "", "expected a JSON object with \"follicle_scene\": 1, got " + describe_json(j));
+    json_fail(src, "",
+              "expected a JSON object with \"follicle_scene\": 1, got " + describe_json(j));
   auto v = j.find("follicle_scene");
   if (v == j.end())
     json_fail(src, "follicle_scene",
@@ -80,6 +81,8 @@ Scene load_scene_file(const std::filesystem::path& path) {
   return read_scene(parse_json_file(path), JsonSource{path.string()});
 }
 
-Json write_scene(const Scene& s) { return to_json(s); }
+Json write_scene(const Scene& s) {
+  return to_json(s);
+}
 
 }  // namespace follicle::scene

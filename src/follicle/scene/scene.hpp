@@ -73,8 +73,8 @@ struct Material {
 
 struct MeshAsset {
   static constexpr const char* kRequired[] = {"path", "units"};
-  std::string name;   // optional id other sections refer to (e.g. hair grows on "head")
-  std::string path;   // relative to the scene file
+  std::string name;  // optional id other sections refer to (e.g. hair grows on "head")
+  std::string path;  // relative to the scene file
   LengthUnit units = LengthUnit::m;
   Transform transform;
   Material material;

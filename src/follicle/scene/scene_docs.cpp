@@ -8,8 +8,12 @@ namespace follicle::scene {
 
 namespace {
 
-std::string begin_marker(const std::string& name) { return "<!-- generated:" + name + " -->\n"; }
-std::string end_marker(const std::string& name) { return "<!-- end generated:" + name + " -->"; }
+std::string begin_marker(const std::string& name) {
+  return "<!-- generated:" + name + " -->\n";
+}
+std::string end_marker(const std::string& name) {
+  return "<!-- end generated:" + name + " -->";
+}
 
 // Finds [content_begin, content_end) of block `name`; false when absent.
 bool find_block(const std::string& md, const std::string& name, std::size_t& b, std::size_t& e) {

@@ -32,7 +32,9 @@ Session Session::from_json(const Json& j, const std::filesystem::path& base_dir,
 
 Session::Session(Scene scene, std::filesystem::path base_dir, std::string source_name,
                  const Context& ctx)
-    : m_scene(std::move(scene)), m_base_dir(std::move(base_dir)), m_source(std::move(source_name)),
+    : m_scene(std::move(scene)),
+      m_base_dir(std::move(base_dir)),
+      m_source(std::move(source_name)),
       m_ctx(&ctx) {
   validate();
 }
@@ -159,16 +161,16 @@ std::string Session::summary() const {
   if (!m_scene.description.empty()) out += fmt::format("description: {}\n", m_scene.description);
   out += fmt::format("meshes: {}\n", m_scene.assets.meshes.size());
   for (const auto& m : m_scene.assets.meshes) {
-    out += fmt::format("  {} {} [{}]{}{}\n", m.name.empty() ? "-" : m.name, m.path,
-                       to_string(m.units),
-                       m.material.texture.empty() ? "" : ", texture " + m.material.texture,
-                       m.visible ? "" : ", hidden");
+    out +=
+        fmt::format("  {} {} [{}]{}{}\n", m.name.empty() ? "-" : m.name, m.path, to_string(m.units),
+                    m.material.texture.empty() ? "" : ", texture " + m.material.texture,
+                    m.visible ? "" : ", hidden");
   }
   const auto& c = m_scene.camera;
-  out += fmt::format("camera: eye ({:.3f}, {:.3f}, {:.3f}) m, target ({:.3f}, {:.3f}, {:.3f}) m, "
-                     "fov {} deg\n",
-                     c.eye.x(), c.eye.y(), c.eye.z(), c.target.x(), c.target.y(), c.target.z(),
-                     c.fov_deg);
+  out += fmt::format(
+      "camera: eye ({:.3f}, {:.3f}, {:.3f}) m, target ({:.3f}, {:.3f}, {:.3f}) m, "
+      "fov {} deg\n",
+      c.eye.x(), c.eye.y(), c.eye.z(), c.target.x(), c.target.y(), c.target.z(), c.fov_deg);
   out += fmt::format("lights: {}\n", m_scene.lights.size());
   out += fmt::format("render: {}x{} px, supersample {}\n", m_scene.render.width,
                      m_scene.render.height, m_scene.render.supersample);

@@ -25,8 +25,7 @@ class Session {
   static Session from_json(const Json& j, const std::filesystem::path& base_dir,
                            const std::string& name_for_errors, const Context& ctx);
   /// From an already built Scene (validated here).
-  Session(Scene scene, std::filesystem::path base_dir, std::string source_name,
-          const Context& ctx);
+  Session(Scene scene, std::filesystem::path base_dir, std::string source_name, const Context& ctx);
 
   const Scene& scene() const { return m_scene; }
   /// For command-line overrides (e.g. --width); call validate() after editing.

@@ -89,11 +89,14 @@ Vec3 Ellipsoid::closest_point(const Vec3& p) const {
   return centre + rotation * x;
 }
 
-void EllipsoidFitParams::validate() const { validate_params(*this, "ellipsoid_fit"); }
+void EllipsoidFitParams::validate() const {
+  validate_params(*this, "ellipsoid_fit");
+}
 
 Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions, const EllipsoidFitParams& params) {
   params.validate();
-  if (positions.size() < 9) fail("ellipsoid fit: need at least 9 vertices, got {}", positions.size());
+  if (positions.size() < 9)
+    fail("ellipsoid fit: need at least 9 vertices, got {}", positions.size());
   double ymax = -1e300;
   for (const auto& p : positions) {
     if (!p.allFinite()) fail("ellipsoid fit: a vertex is not finite");
@@ -121,7 +124,8 @@ Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions, const Ellipsoid
   bool good = c[0] > 0 && c[1] > 0 && c[2] > 0;
   if (good) {
     const Vec3 cen(-c[3] / (2 * c[0]), -c[4] / (2 * c[1]), -c[5] / (2 * c[2]));
-    const double g = 1 + c[0] * cen.x() * cen.x() + c[1] * cen.y() * cen.y() + c[2] * cen.z() * cen.z();
+    const double g =
+        1 + c[0] * cen.x() * cen.x() + c[1] * cen.y() * cen.y() + c[2] * cen.z() * cen.z();
     good = g > 0;
     if (good) {
       centre = mean + scale * cen;

@@ -16,9 +16,9 @@
 namespace follicle::sim {
 
 struct Ellipsoid {
-  Vec3 centre = Vec3::Zero();          // [m]
-  Vec3 radii = Vec3::Ones();           // [m] semi-axes along local x, y, z
-  Mat3 rotation = Mat3::Identity();    // columns: local axes in world
+  Vec3 centre = Vec3::Zero();        // [m]
+  Vec3 radii = Vec3::Ones();         // [m] semi-axes along local x, y, z
+  Mat3 rotation = Mat3::Identity();  // columns: local axes in world
 
   /// Normalized hull coordinates q (unit sphere = hull surface).
   Vec3 normalized(const Vec3& p) const {
@@ -56,11 +56,11 @@ struct Ellipsoid {
 
 /// How to fit a hull to a head mesh (see fit_head_ellipsoid).
 struct EllipsoidFitParams {
-  double cap_depth = 0.11;     // [m] vertices within this distance below the highest one (the cranium)
-  double coverage = 0.985;     // fraction of cranium vertices that must end up inside the hull
-  double margin = 0.002;       // [m] added to every semi-axis afterwards
-  double max_aspect = 1.6;     // semi-axes are clamped to [min_r, max_aspect * min_r] (cap fits are
-                               // unconstrained below)
+  double cap_depth = 0.11;  // [m] vertices within this distance below the highest one (the cranium)
+  double coverage = 0.985;  // fraction of cranium vertices that must end up inside the hull
+  double margin = 0.002;    // [m] added to every semi-axis afterwards
+  double max_aspect = 1.6;  // semi-axes are clamped to [min_r, max_aspect * min_r] (cap fits are
+                            // unconstrained below)
 
   template <class V>
   void visit(V&& v) {
@@ -78,6 +78,7 @@ struct EllipsoidFitParams {
 /// weakly determined, hence the aspect clamp), then scales the semi-axes about the centre so
 /// that `coverage` of the cap lies inside, and adds `margin`. Throws follicle::Error when the
 /// mesh has too few vertices or the fit degenerates.
-Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions, const EllipsoidFitParams& params = {});
+Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions,
+                             const EllipsoidFitParams& params = {});
 
 }  // namespace follicle::sim

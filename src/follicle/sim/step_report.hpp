@@ -16,11 +16,11 @@ struct StepReport {
   static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
 
   bool ok = true;
-  bool non_finite = false;     // a NaN or Inf appeared in the state
-  bool blow_up = false;        // max_speed exceeded the solver's limit
-  double max_speed = 0.0;      // [m/s] largest speed of any point this step
+  bool non_finite = false;       // a NaN or Inf appeared in the state
+  bool blow_up = false;          // max_speed exceeded the solver's limit
+  double max_speed = 0.0;        // [m/s] largest speed of any point this step
   std::size_t first_bad = npos;  // smallest index of an offending item, npos when ok
-  std::string message;         // empty when ok
+  std::string message;           // empty when ok
 
   /// Records a non-finite value at `item` (keeps the smallest index, so the report does not
   /// depend on the order in which parallel chunks are merged).
@@ -47,9 +47,9 @@ struct StepReport {
   void finish(const char* solver, double speed_limit) {
     if (ok) return;
     message = std::string(solver) + ": " +
-              (non_finite ? "state became NaN/Inf" : "blow-up: speed above limit") +
-              " at item " + std::to_string(first_bad) + " (max speed " +
-              std::to_string(max_speed) + " m/s, limit " + std::to_string(speed_limit) + " m/s)";
+              (non_finite ? "state became NaN/Inf" : "blow-up: speed above limit") + " at item " +
+              std::to_string(first_bad) + " (max speed " + std::to_string(max_speed) +
+              " m/s, limit " + std::to_string(speed_limit) + " m/s)";
   }
 };
 

@@ -16,7 +16,8 @@ uint64_t key(int a, int b) {
 }
 }  // namespace
 
-RefinedMesh refine_around_wrinkles(const geom::TriMesh& base, const std::vector<LargeWrinkle>& wrinkles,
+RefinedMesh refine_around_wrinkles(const geom::TriMesh& base,
+                                   const std::vector<LargeWrinkle>& wrinkles,
                                    const RefineParams& params) {
   params.validate();
   base.check("refine");
@@ -44,7 +45,8 @@ RefinedMesh refine_around_wrinkles(const geom::TriMesh& base, const std::vector<
     for (std::size_t f = 0; f < m.faces.size(); ++f) {
       const auto& uv = tex.face_uv[f];
       const Vec2 c = (uv[0] + uv[1] + uv[2]) / 3.0;
-      const double fsize = std::max({(uv[1] - uv[0]).norm(), (uv[2] - uv[1]).norm(), (uv[0] - uv[2]).norm()});
+      const double fsize =
+          std::max({(uv[1] - uv[0]).norm(), (uv[2] - uv[1]).norm(), (uv[0] - uv[2]).norm()});
       for (std::size_t w = 0; w < wrinkles.size(); ++w) {
         const double band = params.region_widths * wrinkles[w].width / scale + fsize;
         Eigen::AlignedBox2d box = curves[w].bounds();
@@ -54,7 +56,8 @@ RefinedMesh refine_around_wrinkles(const geom::TriMesh& base, const std::vector<
         const double target = params.edge_factor * wrinkles[w].width;
         for (int k = 0; k < 3; ++k) {
           const int a = m.faces[f][k], b = m.faces[f][(k + 1) % 3];
-          if ((m.positions[std::size_t(a)] - m.positions[std::size_t(b)]).norm() > target) split.emplace(key(a, b), -1);
+          if ((m.positions[std::size_t(a)] - m.positions[std::size_t(b)]).norm() > target)
+            split.emplace(key(a, b), -1);
         }
       }
     }

@@ -22,7 +22,8 @@ struct RefineParams {
   void visit(V&& v) {
     v("max_levels", max_levels, ParamInfo{"refinement passes", "", 0, 8});
     v("edge_factor", edge_factor, ParamInfo{"target edge length / wrinkle width", "", 0.05, 10.0});
-    v("region_widths", region_widths, ParamInfo{"refined band half-width in wrinkle widths", "", 0.0, 50.0});
+    v("region_widths", region_widths,
+      ParamInfo{"refined band half-width in wrinkle widths", "", 0.0, 50.0});
   }
   void validate() const { validate_params(*this, "refine"); }
 };
@@ -39,14 +40,16 @@ struct RefinedMesh {
   std::vector<T> propagate(const std::vector<T>& base) const {
     std::vector<T> out(base);
     out.reserve(mesh.positions.size());
-    for (const auto& p : parents) out.push_back(T(0.5 * (out[std::size_t(p[0])] + out[std::size_t(p[1])])));
+    for (const auto& p : parents)
+      out.push_back(T(0.5 * (out[std::size_t(p[0])] + out[std::size_t(p[1])])));
     return out;
   }
 };
 
 /// Refines `base` (which must have UVs) around the wrinkles. With no wrinkles or max_levels = 0
 /// the mesh is returned unchanged.
-RefinedMesh refine_around_wrinkles(const geom::TriMesh& base, const std::vector<LargeWrinkle>& wrinkles,
+RefinedMesh refine_around_wrinkles(const geom::TriMesh& base,
+                                   const std::vector<LargeWrinkle>& wrinkles,
                                    const RefineParams& params);
 
 /// Number of T-junctions: mesh vertices lying strictly inside an edge of a face that does not use

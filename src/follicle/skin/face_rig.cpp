@@ -5,25 +5,34 @@
 
 namespace follicle::skin {
 
-void compute_vertex_normals(const Context& ctx, const geom::TriMesh& topo, const TextureSpaceMesh& tex,
-                            const std::vector<Vec3>& p, std::vector<Vec3>& face_n, std::vector<double>& face_area,
+void compute_vertex_normals(const Context& ctx, const geom::TriMesh& topo,
+                            const TextureSpaceMesh& tex, const std::vector<Vec3>& p,
+                            std::vector<Vec3>& face_n, std::vector<double>& face_area,
                             std::vector<Vec3>& normals) {
   const std::size_t nf = topo.faces.size(), nv = p.size();
   face_n.resize(nf);
   face_area.resize(nf);
-  parallel_for(ctx, 0, nf, [&](std::size_t f) {
-    const Vec3i& t = topo.faces[f];
-    const Vec3 c = (p[std::size_t(t[1])] - p[std::size_t(t[0])]).cross(p[std::size_t(t[2])] - p[std::size_t(t[0])]);
-    face_n[f] = c;  // |c| = 2 area: area weighting for free
-    face_area[f] = 0.5 * c.norm();
-  }, 2048);
+  parallel_for(
+      ctx, 0, nf,
+      [&](std::size_t f) {
+        const Vec3i& t = topo.faces[f];
+        const Vec3 c = (p[std::size_t(t[1])] - p[std::size_t(t[0])])
+                           .cross(p[std::size_t(t[2])] - p[std::size_t(t[0])]);
+        face_n[f] = c;  // |c| = 2 area: area weighting for free
+        face_area[f] = 0.5 * c.norm();
+      },
+      2048);
   normals.resize(nv);
-  parallel_for(ctx, 0, nv, [&](std::size_t v) {
-    Vec3 n = Vec3::Zero();
-    for (std::size_t k = tex.vf_offsets[v]; k < tex.vf_offsets[v + 1]; ++k) n += face_n[std::size_t(tex.vf_faces[k])];
-    const double len = n.norm();
-    normals[v] = len > 0 ? Vec3(n / len) : Vec3(0, 0, 1);
-  }, 2048);
+  parallel_for(
+      ctx, 0, nv,
+      [&](std::size_t v) {
+        Vec3 n = Vec3::Zero();
+        for (std::size_t k = tex.vf_offsets[v]; k < tex.vf_offsets[v + 1]; ++k)
+          n += face_n[std::size_t(tex.vf_faces[k])];
+        const double len = n.norm();
+        normals[v] = len > 0 ? Vec3(n / len) : Vec3(0, 0, 1);
+      },
+      2048);
 }
 
 FaceRig::FaceRig(const geom::TriMesh& base, MuscleSet muscles, std::vector<LargeWrinkle> wrinkles,
@@ -32,7 +41,8 @@ FaceRig::FaceRig(const geom::TriMesh& base, MuscleSet muscles, std::vector<Large
   m_params.validate();
   m_muscles.validate();
   m_refined = refine_around_wrinkles(base, wrinkles, m_params.refine);
-  m_wrinkles = std::make_unique<WrinkleLayer>(m_refined.mesh, std::move(wrinkles), m_params.wrinkle_cutoff_widths);
+  m_wrinkles = std::make_unique<WrinkleLayer>(m_refined.mesh, std::move(wrinkles),
+                                              m_params.wrinkle_cutoff_widths);
   m_field = std::make_unique<MuscleField>(m_muscles, m_refined.mesh.positions);
   m_tissue = std::make_unique<SubcutaneousTissue>(
       m_refined.mesh, m_wrinkles->texture_mesh(),
@@ -62,7 +72,10 @@ void FaceRig::update(const Context& ctx, const MusclePose& pose, FaceState& s) c
   s.animated.resize(nv);
   if (m_params.tissue.enabled) {
     m_tissue->offsets(ctx, s.face_area, s.offsets);
-    parallel_for(ctx, 0, nv, [&](std::size_t i) { s.animated[i] = s.muscle_pos[i] + s.offsets[i] * s.normals[i]; }, 2048);
+    parallel_for(
+        ctx, 0, nv,
+        [&](std::size_t i) { s.animated[i] = s.muscle_pos[i] + s.offsets[i] * s.normals[i]; },
+        2048);
     compute_vertex_normals(ctx, rest, tex, s.animated, s.face_n, s.face_area, s.normals);
   } else {
     s.animated = s.muscle_pos;
@@ -71,7 +84,10 @@ void FaceRig::update(const Context& ctx, const MusclePose& pose, FaceState& s) c
   s.positions.resize(nv);
   if (m_params.wrinkles_enabled && m_wrinkles->num_wrinkles() > 0) {
     m_wrinkles->heights(ctx, s.animated, s.wrinkle_height);
-    parallel_for(ctx, 0, nv, [&](std::size_t i) { s.positions[i] = s.animated[i] + s.wrinkle_height[i] * s.normals[i]; }, 2048);
+    parallel_for(
+        ctx, 0, nv,
+        [&](std::size_t i) { s.positions[i] = s.animated[i] + s.wrinkle_height[i] * s.normals[i]; },
+        2048);
     compute_vertex_normals(ctx, rest, tex, s.positions, s.face_n, s.face_area, s.normals);
   } else {
     s.wrinkle_height.assign(nv, 0.0);
@@ -81,7 +97,8 @@ void FaceRig::update(const Context& ctx, const MusclePose& pose, FaceState& s) c
 
 geom::TriMesh FaceRig::deformed_mesh(const FaceState& s) const {
   geom::TriMesh m = m_refined.mesh;
-  if (s.positions.size() != m.positions.size()) fail("deformed_mesh: state has {} vertices, rig {}", s.positions.size(), m.positions.size());
+  if (s.positions.size() != m.positions.size())
+    fail("deformed_mesh: state has {} vertices, rig {}", s.positions.size(), m.positions.size());
   m.positions = s.positions;
   m.normals = s.normals;
   return m;

@@ -28,16 +28,17 @@ struct FaceRigParams {
     v("tissue", tissue, ParamInfo{"subcutaneous tissue", ""});
     v("refine", refine, ParamInfo{"adaptive refinement", ""});
     v("wrinkles_enabled", wrinkles_enabled, ParamInfo{"apply large-scale wrinkles", ""});
-    v("wrinkle_cutoff_widths", wrinkle_cutoff_widths, ParamInfo{"shape function cut-off in widths", "", 4.0, 50.0});
+    v("wrinkle_cutoff_widths", wrinkle_cutoff_widths,
+      ParamInfo{"shape function cut-off in widths", "", 4.0, 50.0});
   }
   void validate() const { validate_params(*this, "face_rig"); }
 };
 
 /// Output of one update (also holds scratch buffers; reuse it across frames).
 struct FaceState {
-  std::vector<Vec3> positions;      // final skin surface [m]
-  std::vector<Vec3> normals;        // of the final surface
-  std::vector<Vec3> animated;       // after muscles, jaw and tissue (no wrinkles)
+  std::vector<Vec3> positions;         // final skin surface [m]
+  std::vector<Vec3> normals;           // of the final surface
+  std::vector<Vec3> animated;          // after muscles, jaw and tissue (no wrinkles)
   std::vector<double> wrinkle_height;  // per vertex, sum of M(s) S(l) [m]
   // scratch
   std::vector<Vec3> muscle_pos, face_n;
@@ -69,7 +70,9 @@ class FaceRig {
   geom::TriMesh deformed_mesh(const FaceState& s) const;
 
   /// Edits one wrinkle; only its affected vertices are recomputed (no re-refinement).
-  std::size_t set_wrinkle(std::size_t i, const LargeWrinkle& w) { return m_wrinkles->set_wrinkle(i, w); }
+  std::size_t set_wrinkle(std::size_t i, const LargeWrinkle& w) {
+    return m_wrinkles->set_wrinkle(i, w);
+  }
   void set_wrinkles_enabled(bool on) { m_params.wrinkles_enabled = on; }
 
  private:
@@ -82,8 +85,9 @@ class FaceRig {
 };
 
 /// Area-weighted vertex normals, parallel and deterministic (vertex -> face CSR of `tex`).
-void compute_vertex_normals(const Context& ctx, const geom::TriMesh& topo, const TextureSpaceMesh& tex,
-                            const std::vector<Vec3>& positions, std::vector<Vec3>& face_n,
-                            std::vector<double>& face_area, std::vector<Vec3>& normals);
+void compute_vertex_normals(const Context& ctx, const geom::TriMesh& topo,
+                            const TextureSpaceMesh& tex, const std::vector<Vec3>& positions,
+                            std::vector<Vec3>& face_n, std::vector<double>& face_area,
+                            std::vector<Vec3>& normals);
 
 }  // namespace follicle::skin

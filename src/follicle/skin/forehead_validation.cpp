@@ -44,10 +44,11 @@ ForeheadCase make_forehead_case(const Context& ctx, const ForeheadCaseParams& p)
     const double y = (k - 0.5 * (p.furrows - 1)) * p.spacing;
     ys.push_back(y);
     LargeWrinkle w;
-    w.name = "furrow" + std::to_string(k);
+    w.name = fmt::format("furrow{}", k);
     const double v = (y + 0.5 * p.height) / size;
     const double u0 = -0.2, u1 = p.width / size + 0.2;  // beyond the patch: no end taper inside
-    w.control = {Vec2(u0, v), Vec2(u0 + (u1 - u0) / 3, v), Vec2(u0 + 2 * (u1 - u0) / 3, v), Vec2(u1, v)};
+    w.control = {Vec2(u0, v), Vec2(u0 + (u1 - u0) / 3, v), Vec2(u0 + 2 * (u1 - u0) / 3, v),
+                 Vec2(u1, v)};
     w.depth = p.depth;
     w.width = p.wrinkle_width;
     w.r = p.r;
@@ -86,7 +87,8 @@ ForeheadCase make_forehead_case(const Context& ctx, const ForeheadCaseParams& p)
   for (auto& q : R.positions) {
     const double y = q.y();
     double H = 0;
-    for (double yk : ys) H += M * wrinkle_shape(std::abs(y - yk), p.depth, p.wrinkle_width);  // (2.1)(2.4)
+    for (double yk : ys)
+      H += M * wrinkle_shape(std::abs(y - yk), p.depth, p.wrinkle_width);  // (2.1)(2.4)
     const Vec3 radial = Vec3(q.x(), 0, q.z()).normalized();
     q = (p.radius + H) * radial + Vec3(0, (1.0 - p.shrink) * y, 0);
   }

@@ -15,16 +15,16 @@
 namespace follicle::skin {
 
 struct ForeheadCaseParams {
-  double width = 0.10;          // arc length [m]
-  double height = 0.06;         // [m]
-  double radius = 0.08;         // forehead curvature radius [m]
-  double grid = 0.003;          // coarse mesh spacing [m]
-  double shrink = 0.5;          // s0, vertical shrinkage
-  double depth = 0.010;         // d [m]: furrow depth M(s0) d = 5 mm for s0 = 0.5, r = 0
-  double wrinkle_width = 0.004; // w [m]
+  double width = 0.10;           // arc length [m]
+  double height = 0.06;          // [m]
+  double radius = 0.08;          // forehead curvature radius [m]
+  double grid = 0.003;           // coarse mesh spacing [m]
+  double shrink = 0.5;           // s0, vertical shrinkage
+  double depth = 0.010;          // d [m]: furrow depth M(s0) d = 5 mm for s0 = 0.5, r = 0
+  double wrinkle_width = 0.004;  // w [m]
   double r = 0.0;
   int furrows = 3;
-  double spacing = 0.014;       // between furrows [m]
+  double spacing = 0.014;          // between furrows [m]
   double reference_grid = 0.0005;  // analytic reference mesh spacing [m]
   RefineParams refine{4, 0.25, 6.0};
   template <class V>
@@ -46,11 +46,11 @@ struct ForeheadCaseParams {
 };
 
 struct ForeheadCase {
-  geom::TriMesh rest;       // coarse patch with UVs
+  geom::TriMesh rest;  // coarse patch with UVs
   std::vector<LargeWrinkle> wrinkles;
-  geom::TriMesh generated;  // refined, shrunk, wrinkled by the method
-  geom::TriMesh reference;  // analytic surface (fine grid)
-  double mean_shrinkage = 0;  // mean computed s over all wrinkle entries
+  geom::TriMesh generated;         // refined, shrunk, wrinkled by the method
+  geom::TriMesh reference;         // analytic surface (fine grid)
+  double mean_shrinkage = 0;       // mean computed s over all wrinkle entries
   double max_shrinkage_error = 0;  // max |s - s0|
 };
 

@@ -35,7 +35,8 @@ CurveProjection BezierDistance::project(const Vec2& q) const {
   for (int it = 0; it < 3; ++it) {
     const Vec2 b = m_c.eval(bt), d1 = m_c.tangent(bt);
     const double u = 1 - bt;
-    const Vec2 d2 = 6 * u * (m_c.p[2] - 2 * m_c.p[1] + m_c.p[0]) + 6 * bt * (m_c.p[3] - 2 * m_c.p[2] + m_c.p[1]);
+    const Vec2 d2 = 6 * u * (m_c.p[2] - 2 * m_c.p[1] + m_c.p[0]) +
+                    6 * bt * (m_c.p[3] - 2 * m_c.p[2] + m_c.p[1]);
     const double f = (b - q).dot(d1), fp = d1.dot(d1) + (b - q).dot(d2);
     if (std::abs(fp) < 1e-300) break;
     bt = std::clamp(bt - f / fp, 0.0, 1.0);
@@ -51,7 +52,8 @@ CurveProjection BezierDistance::project(const Vec2& q) const {
 }
 
 TextureSpaceMesh TextureSpaceMesh::build(const geom::TriMesh& mesh) {
-  if (!mesh.has_uvs()) fail("wrinkles: the mesh has no texture coordinates (map it to texture space first)");
+  if (!mesh.has_uvs())
+    fail("wrinkles: the mesh has no texture coordinates (map it to texture space first)");
   TextureSpaceMesh t;
   const std::size_t nv = mesh.positions.size(), nf = mesh.faces.size();
   t.vertex_uv.assign(nv, Vec2::Zero());
@@ -83,7 +85,8 @@ TextureSpaceMesh TextureSpaceMesh::build(const geom::TriMesh& mesh) {
   return t;
 }
 
-double texture_scale(const geom::TriMesh& mesh, const TextureSpaceMesh& tex, const std::vector<int>& faces) {
+double texture_scale(const geom::TriMesh& mesh, const TextureSpaceMesh& tex,
+                     const std::vector<int>& faces) {
   double a3 = 0, auv = 0;
   for (int f : faces) {
     a3 += mesh.face_area(std::size_t(f));
@@ -94,9 +97,12 @@ double texture_scale(const geom::TriMesh& mesh, const TextureSpaceMesh& tex, con
   return auv > 0 ? std::sqrt(a3 / auv) : 1.0;
 }
 
-WrinkleLayer::WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> wrinkles, double cutoff_widths,
-                           ShrinkageMethod method)
-    : m_rest(rest), m_tex(TextureSpaceMesh::build(rest)), m_wrinkles(std::move(wrinkles)), m_cutoff(cutoff_widths),
+WrinkleLayer::WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> wrinkles,
+                           double cutoff_widths, ShrinkageMethod method)
+    : m_rest(rest),
+      m_tex(TextureSpaceMesh::build(rest)),
+      m_wrinkles(std::move(wrinkles)),
+      m_cutoff(cutoff_widths),
       m_method(method) {
   std::vector<int> all(rest.faces.size());
   for (std::size_t f = 0; f < all.size(); ++f) all[f] = int(f);
@@ -109,7 +115,8 @@ WrinkleLayer::WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> 
 }
 
 std::size_t WrinkleLayer::set_wrinkle(std::size_t i, const LargeWrinkle& w) {
-  if (i >= m_wrinkles.size()) fail("set_wrinkle: index {} out of range ({} wrinkles)", i, m_wrinkles.size());
+  if (i >= m_wrinkles.size())
+    fail("set_wrinkle: index {} out of range ({} wrinkles)", i, m_wrinkles.size());
   w.validate();
   const std::size_t before = m_infl[i].entries.size();
   m_wrinkles[i] = w;
@@ -206,27 +213,32 @@ void WrinkleLayer::shrinkage(const Context& ctx, std::size_t i, const std::vecto
                              std::vector<double>& s) const {
   const auto& entries = m_infl[i].entries;
   s.resize(entries.size());
-  parallel_for(ctx, 0, entries.size(), [&](std::size_t k) {
-    const auto& e = entries[k];
-    double acc = 0;
-    const Vec3& p1 = p[std::size_t(e.vertex)];
-    for (int j = 0; j < e.nsides; ++j) {
-      const auto& sd = e.side[std::size_t(j)];
-      const Vec3 x2 = p[std::size_t(sd.j2)] - p1, x3 = p[std::size_t(sd.j3)] - p1;
-      if (m_method == ShrinkageMethod::edge_scaling) {
-        acc += triangle_shrinkage(sd.a, sd.b, x2.norm() / sd.rest2, x3.norm() / sd.rest3);  // (2.3)
-      } else {
-        acc += 1.0 - (sd.a * x2 + sd.b * x3).norm() / sd.rest_span;  // (2.3) s = 1 - L'/L
-      }
-    }
-    s[k] = e.nsides > 0 ? acc / e.nsides : 0.0;  // average of the +d_p and -d_p triangles
-  }, 512);
+  parallel_for(
+      ctx, 0, entries.size(),
+      [&](std::size_t k) {
+        const auto& e = entries[k];
+        double acc = 0;
+        const Vec3& p1 = p[std::size_t(e.vertex)];
+        for (int j = 0; j < e.nsides; ++j) {
+          const auto& sd = e.side[std::size_t(j)];
+          const Vec3 x2 = p[std::size_t(sd.j2)] - p1, x3 = p[std::size_t(sd.j3)] - p1;
+          if (m_method == ShrinkageMethod::edge_scaling) {
+            acc += triangle_shrinkage(sd.a, sd.b, x2.norm() / sd.rest2,
+                                      x3.norm() / sd.rest3);  // (2.3)
+          } else {
+            acc += 1.0 - (sd.a * x2 + sd.b * x3).norm() / sd.rest_span;  // (2.3) s = 1 - L'/L
+          }
+        }
+        s[k] = e.nsides > 0 ? acc / e.nsides : 0.0;  // average of the +d_p and -d_p triangles
+      },
+      512);
 }
 
 void WrinkleLayer::heights(const Context& ctx, const std::vector<Vec3>& deformed,
                            std::vector<double>& height) const {
   if (deformed.size() != m_rest.positions.size())
-    fail("wrinkle heights: {} positions for a {}-vertex rest mesh", deformed.size(), m_rest.positions.size());
+    fail("wrinkle heights: {} positions for a {}-vertex rest mesh", deformed.size(),
+         m_rest.positions.size());
   height.assign(deformed.size(), 0.0);
   std::vector<double> s;
   for (std::size_t i = 0; i < m_wrinkles.size(); ++i) {
@@ -235,7 +247,8 @@ void WrinkleLayer::heights(const Context& ctx, const std::vector<Vec3>& deformed
     const auto& entries = m_infl[i].entries;
     // Fixed wrinkle order, sequential accumulation: bit-identical for any thread count.
     for (std::size_t k = 0; k < entries.size(); ++k)
-      height[std::size_t(entries[k].vertex)] += amplitude_modulation(s[k], r) * entries[k].shape;  // (2.4)
+      height[std::size_t(entries[k].vertex)] +=
+          amplitude_modulation(s[k], r) * entries[k].shape;  // (2.4)
   }
 }
 

@@ -18,10 +18,11 @@ namespace follicle::skin {
 
 struct LargeWrinkle {
   std::string name;
-  std::array<Vec2, 4> control{Vec2(0.4, 0.5), Vec2(0.45, 0.5), Vec2(0.55, 0.5), Vec2(0.6, 0.5)};  // texture space
-  double depth = 0.003;   // d [m]
-  double width = 0.003;   // w [m]
-  double r = 0.0;         // (2.4) rest amplitude ratio in [0, 1]
+  std::array<Vec2, 4> control{Vec2(0.4, 0.5), Vec2(0.45, 0.5), Vec2(0.55, 0.5),
+                              Vec2(0.6, 0.5)};  // texture space
+  double depth = 0.003;                         // d [m]
+  double width = 0.003;                         // w [m]
+  double r = 0.0;                               // (2.4) rest amplitude ratio in [0, 1]
   double end_taper = 0.15;  // fraction of the curve parameter over which depth fades at each end
   template <class V>
   void visit(V&& v) {
@@ -41,19 +42,19 @@ struct LargeWrinkle {
 
 /// Texture-space view of a mesh with the adjacency the wrinkle code needs.
 struct TextureSpaceMesh {
-  std::vector<Vec2> vertex_uv;             // one UV per position vertex (first occurrence)
+  std::vector<Vec2> vertex_uv;               // one UV per position vertex (first occurrence)
   std::vector<std::array<Vec2, 3>> face_uv;  // per face corner (consistent inside a face)
-  std::vector<std::size_t> vf_offsets;     // vertex -> incident faces (CSR)
+  std::vector<std::size_t> vf_offsets;       // vertex -> incident faces (CSR)
   std::vector<int> vf_faces;
-  std::vector<char> vf_corner;             // corner index of the vertex in that face
+  std::vector<char> vf_corner;  // corner index of the vertex in that face
   static TextureSpaceMesh build(const geom::TriMesh& mesh);
 };
 
 /// Precomputed data of one wrinkle on one rest mesh; rebuilt alone when its parameters change.
 struct WrinkleInfluence {
   struct Side {
-    int j2 = -1, j3 = -1;     // the other two vertices of the triangle in direction +-d_p
-    double a = 0, b = 0;      // d_p = a e2 + b e3 in texture space
+    int j2 = -1, j3 = -1;         // the other two vertices of the triangle in direction +-d_p
+    double a = 0, b = 0;          // d_p = a e2 + b e3 in texture space
     double rest2 = 0, rest3 = 0;  // rest 3D lengths of edges v1v2, v1v3
     double rest_span = 0;         // |a X2 + b X3| in the rest 3D triangle
   };
@@ -99,7 +100,8 @@ class WrinkleLayer {
                  std::vector<double>& s) const;
   /// Per-vertex scalar height h_v = sum_wrinkles M(s) S(l) (2.1)(2.4) on the deformed positions.
   /// `height` is resized and overwritten.
-  void heights(const Context& ctx, const std::vector<Vec3>& deformed, std::vector<double>& height) const;
+  void heights(const Context& ctx, const std::vector<Vec3>& deformed,
+               std::vector<double>& height) const;
   /// Rest-state heights (s = 0, i.e. M = r), e.g. for the aged face.
   void rest_heights(std::vector<double>& height) const;
 

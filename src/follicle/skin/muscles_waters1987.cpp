@@ -14,7 +14,8 @@ void LinearMuscle::validate() const {
   validate_params(*this, where);
   if ((insertion - origin).norm() < 1e-9) fail_at(where, "origin and insertion coincide");
   if (falloff_start >= falloff_end)
-    fail_at(where, "falloff_start {} must be smaller than falloff_end {}", falloff_start, falloff_end);
+    fail_at(where, "falloff_start {} must be smaller than falloff_end {}", falloff_start,
+            falloff_end);
 }
 
 void SphincterMuscle::validate() const {
@@ -36,10 +37,12 @@ void MuscleSet::validate() const {
   for (std::size_t i = 0; i < linear.size(); ++i) {
     if (linear[i].name.empty()) fail_at(fmt::format("linear[{}]", i), "a muscle needs a name");
     linear[i].validate();
-    if (!names.insert(linear[i].name).second) fail_at(fmt::format("linear[{}]", i), "duplicate muscle name '{}'", linear[i].name);
+    if (!names.insert(linear[i].name).second)
+      fail_at(fmt::format("linear[{}]", i), "duplicate muscle name '{}'", linear[i].name);
   }
   for (std::size_t i = 0; i < sphincter.size(); ++i) {
-    if (sphincter[i].name.empty()) fail_at(fmt::format("sphincter[{}]", i), "a muscle needs a name");
+    if (sphincter[i].name.empty())
+      fail_at(fmt::format("sphincter[{}]", i), "a muscle needs a name");
     sphincter[i].validate();
     if (!names.insert(sphincter[i].name).second)
       fail_at(fmt::format("sphincter[{}]", i), "duplicate muscle name '{}'", sphincter[i].name);
@@ -52,7 +55,8 @@ void MuscleSet::validate() const {
       muscle_index(m);  // throws with did-you-mean
     }
     if (std::abs(e.jaw_angle) > jaw.max_angle + 1e-12)
-      fail_at("expression '" + e.name + "'", "jaw_angle {} exceeds jaw.max_angle {}", e.jaw_angle, jaw.max_angle);
+      fail_at("expression '" + e.name + "'", "jaw_angle {} exceeds jaw.max_angle {}", e.jaw_angle,
+              jaw.max_angle);
   }
 }
 
@@ -68,7 +72,8 @@ int MuscleSet::muscle_index(const std::string& name) const {
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return int(i);
   const std::string dym = did_you_mean(name, names);
-  fail("unknown muscle '{}'{}", name, dym.empty() ? std::string() : " (did you mean '" + dym + "'?)");
+  fail("unknown muscle '{}'{}", name,
+       dym.empty() ? std::string() : " (did you mean '" + dym + "'?)");
 }
 
 const Expression& MuscleSet::expression(const std::string& name) const {
@@ -78,13 +83,15 @@ const Expression& MuscleSet::expression(const std::string& name) const {
     names.push_back(e.name);
   }
   const std::string dym = did_you_mean(name, names);
-  fail("unknown expression '{}'{}", name, dym.empty() ? std::string() : " (did you mean '" + dym + "'?)");
+  fail("unknown expression '{}'{}", name,
+       dym.empty() ? std::string() : " (did you mean '" + dym + "'?)");
 }
 
 MusclePose pose_from_expression(const MuscleSet& set, const Expression& e, double weight) {
   MusclePose p;
   p.contractions.assign(set.num_muscles(), 0.0);
-  for (const auto& [name, k] : e.contractions) p.contractions[std::size_t(set.muscle_index(name))] = weight * k;
+  for (const auto& [name, k] : e.contractions)
+    p.contractions[std::size_t(set.muscle_index(name))] = weight * k;
   p.jaw_angle = weight * e.jaw_angle;
   return p;
 }
@@ -109,7 +116,7 @@ double linear_muscle_factor(const LinearMuscle& m, const Vec3& p) {
   const double cosa = va.dot(vb) / (valen * vblen);
   if (cosa < cos_zone || vblen > m.falloff_end) return 0.0;
   const double angular = 1.0 - cosa / cos_zone;  // <= 0 inside the zone: pulls toward origin
-  double radial = 1.0;                             // cosine radial fall-off
+  double radial = 1.0;                           // cosine radial fall-off
   if (vblen >= m.falloff_start) {
     const double percent = (vblen - m.falloff_start) / (m.falloff_end - m.falloff_start);
     radial = std::cos(percent * 0.5 * kPi);
@@ -130,7 +137,8 @@ double sphincter_factor(const SphincterMuscle& m, const Vec3& p, Vec3* pull) {
   const double rho = std::sqrt((x / a) * (x / a) + (y / b) * (y / b));
   if (rho >= 1.0) return 0.0;
   double f = 1.0;
-  if (rho > m.falloff_start) f = std::cos((rho - m.falloff_start) / (1.0 - m.falloff_start) * 0.5 * kPi);
+  if (rho > m.falloff_start)
+    f = std::cos((rho - m.falloff_start) / (1.0 - m.falloff_start) * 0.5 * kPi);
   *pull = -(x * ea + y * eb);  // toward the centre within the ellipse plane
   return f;
 }
@@ -164,7 +172,8 @@ MuscleField::MuscleField(const MuscleSet& set, const std::vector<Vec3>& rest) : 
   if (m_jaw.enabled) {
     const Vec3 n = m_jaw.plane_normal.normalized();
     for (std::size_t i = 0; i < rest.size(); ++i) {
-      const double w = smoothstep01(((rest[i] - m_jaw.pivot).dot(n) - m_jaw.offset) / m_jaw.blend_width);
+      const double w =
+          smoothstep01(((rest[i] - m_jaw.pivot).dot(n) - m_jaw.offset) / m_jaw.blend_width);
       if (w > 0) m_jaw_weights.emplace_back(int(i), w);
     }
   }
@@ -172,25 +181,34 @@ MuscleField::MuscleField(const MuscleSet& set, const std::vector<Vec3>& rest) : 
 
 void MuscleField::apply(const Context& ctx, const MusclePose& pose, const std::vector<Vec3>& rest,
                         std::vector<Vec3>& out) const {
-  if (rest.size() != num_vertices()) fail("MuscleField: {} rest vertices, built for {}", rest.size(), num_vertices());
+  if (rest.size() != num_vertices())
+    fail("MuscleField: {} rest vertices, built for {}", rest.size(), num_vertices());
   if (pose.contractions.size() != m_num_muscles)
-    fail("MuscleField: pose has {} contractions for {} muscles", pose.contractions.size(), m_num_muscles);
+    fail("MuscleField: pose has {} contractions for {} muscles", pose.contractions.size(),
+         m_num_muscles);
   out.resize(rest.size());
   const double* k = pose.contractions.data();
-  parallel_for(ctx, 0, rest.size(), [&](std::size_t i) {
-    Vec3 p = rest[i];
-    for (std::size_t e = m_offsets[i]; e < m_offsets[i + 1]; ++e) p += k[m_entries[e].muscle] * m_entries[e].d;
-    out[i] = p;
-  }, 1024);
+  parallel_for(
+      ctx, 0, rest.size(),
+      [&](std::size_t i) {
+        Vec3 p = rest[i];
+        for (std::size_t e = m_offsets[i]; e < m_offsets[i + 1]; ++e)
+          p += k[m_entries[e].muscle] * m_entries[e].d;
+        out[i] = p;
+      },
+      1024);
   if (m_jaw.enabled && pose.jaw_angle != 0.0) {
     const Eigen::AngleAxisd rot(pose.jaw_angle, m_jaw.axis.normalized());
     const Mat3 R = rot.toRotationMatrix();
-    parallel_for(ctx, 0, m_jaw_weights.size(), [&](std::size_t j) {
-      const auto [i, w] = m_jaw_weights[j];
-      const Vec3 p = out[std::size_t(i)];
-      const Vec3 q = R * (p - m_jaw.pivot) + m_jaw.pivot;
-      out[std::size_t(i)] = p + w * (q - p);
-    }, 1024);
+    parallel_for(
+        ctx, 0, m_jaw_weights.size(),
+        [&](std::size_t j) {
+          const auto [i, w] = m_jaw_weights[j];
+          const Vec3 p = out[std::size_t(i)];
+          const Vec3 q = R * (p - m_jaw.pivot) + m_jaw.pivot;
+          out[std::size_t(i)] = p + w * (q - p);
+        },
+        1024);
   }
 }
 

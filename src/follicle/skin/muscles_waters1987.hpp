@@ -20,11 +20,11 @@ namespace follicle::skin {
 /// Inside the zone (1 - cos/cos zone) <= 0, so k > 0 pulls the vertex toward the bony origin.
 struct LinearMuscle {
   std::string name;
-  Vec3 origin = Vec3::Zero();     // bony attachment; vertices move toward it [m]
+  Vec3 origin = Vec3::Zero();             // bony attachment; vertices move toward it [m]
   Vec3 insertion = Vec3::UnitZ() * 0.01;  // skin insertion [m]
-  double falloff_start = 0.001;   // fs [m]
-  double falloff_end = 0.04;      // fe [m]
-  double zone = 0.7853981633974483;  // angular zone half-angle [rad]
+  double falloff_start = 0.001;           // fs [m]
+  double falloff_end = 0.04;              // fe [m]
+  double zone = 0.7853981633974483;       // angular zone half-angle [rad]
   template <class V>
   void visit(V&& v) {
     v("name", name, ParamInfo{"muscle name", ""});
@@ -44,18 +44,19 @@ struct LinearMuscle {
 /// up to rho = 1, 0 outside.
 struct SphincterMuscle {
   std::string name;
-  Vec3 center = Vec3::Zero();            // [m]
+  Vec3 center = Vec3::Zero();               // [m]
   Vec3 semi_axis_a = Vec3::UnitX() * 0.03;  // first semi-axis (direction and length) [m]
   Vec3 semi_axis_b = Vec3::UnitY() * 0.02;  // second semi-axis [m]
-  double falloff_start = 0.3;            // fraction of the elliptic radius
-  double depth = 0.03;                   // influence half-depth along the ellipse normal [m]
+  double falloff_start = 0.3;               // fraction of the elliptic radius
+  double depth = 0.03;                      // influence half-depth along the ellipse normal [m]
   template <class V>
   void visit(V&& v) {
     v("name", name, ParamInfo{"muscle name", ""});
     v("center", center, ParamInfo{"ellipse centre", "m", -10.0, 10.0});
     v("semi_axis_a", semi_axis_a, ParamInfo{"first semi-axis vector", "m", -10.0, 10.0});
     v("semi_axis_b", semi_axis_b, ParamInfo{"second semi-axis vector", "m", -10.0, 10.0});
-    v("falloff_start", falloff_start, ParamInfo{"fall-off start (fraction of radius)", "", 0.0, 0.999});
+    v("falloff_start", falloff_start,
+      ParamInfo{"fall-off start (fraction of radius)", "", 0.0, 0.999});
     v("depth", depth, ParamInfo{"influence half-depth along the normal", "m", 1e-6, 10.0});
   }
   void validate() const;

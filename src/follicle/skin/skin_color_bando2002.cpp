@@ -6,35 +6,45 @@
 
 namespace follicle::skin {
 
-std::vector<std::string> skin_color_preset_names() { return {"pale", "caucasian", "asian", "tanned", "african"}; }
+std::vector<std::string> skin_color_preset_names() {
+  return {"pale", "caucasian", "asian", "tanned", "african"};
+}
 
 SkinColorParams skin_color_preset(const std::string& name) {
   SkinColorParams p;
   if (name == "pale") {
-    p.melanin = 0.02; p.hemoglobin = 0.2;
+    p.melanin = 0.02;
+    p.hemoglobin = 0.2;
   } else if (name == "caucasian") {
-    p.melanin = 0.08; p.hemoglobin = 0.35;
+    p.melanin = 0.08;
+    p.hemoglobin = 0.35;
   } else if (name == "asian") {
-    p.melanin = 0.22; p.hemoglobin = 0.3;
+    p.melanin = 0.22;
+    p.hemoglobin = 0.3;
   } else if (name == "tanned") {
-    p.melanin = 0.4; p.hemoglobin = 0.3;
+    p.melanin = 0.4;
+    p.hemoglobin = 0.3;
   } else if (name == "african") {
-    p.melanin = 0.95; p.hemoglobin = 0.4;
+    p.melanin = 0.95;
+    p.hemoglobin = 0.4;
   } else {
     const std::string d = did_you_mean(name, skin_color_preset_names());
-    fail("unknown skin colour preset '{}'{}; expected one of pale, caucasian, asian, tanned, african", name,
-         d.empty() ? std::string() : " (did you mean '" + d + "'?)");
+    fail(
+        "unknown skin colour preset '{}'{}; expected one of pale, caucasian, asian, tanned, "
+        "african",
+        name, d.empty() ? std::string() : " (did you mean '" + d + "'?)");
   }
   return p;
 }
 
 Vec3 skin_color(const SkinColorParams& p) {
-  const Vec3 c = p.base - p.melanin * p.melanin_absorption - p.hemoglobin * p.hemoglobin_absorption;  // (2.6)
+  const Vec3 c =
+      p.base - p.melanin * p.melanin_absorption - p.hemoglobin * p.hemoglobin_absorption;  // (2.6)
   return c.cwiseMax(0.0).cwiseMin(1.0);
 }
 
-std::vector<Vec3> skin_vertex_colors(const SkinColorParams& p, std::size_t n, const std::vector<double>& ms,
-                                     const std::vector<double>& hs) {
+std::vector<Vec3> skin_vertex_colors(const SkinColorParams& p, std::size_t n,
+                                     const std::vector<double>& ms, const std::vector<double>& hs) {
   p.validate();
   if ((!ms.empty() && ms.size() != n) || (!hs.empty() && hs.size() != n))
     fail("skin_vertex_colors: scale arrays must be empty or have {} entries", n);
@@ -48,11 +58,12 @@ std::vector<Vec3> skin_vertex_colors(const SkinColorParams& p, std::size_t n, co
   return out;
 }
 
-image::ImageRGBF skin_color_texture(const SkinColorParams& p, const image::ImageF& mm, const image::ImageF& hm) {
+image::ImageRGBF skin_color_texture(const SkinColorParams& p, const image::ImageF& mm,
+                                    const image::ImageF& hm) {
   p.validate();
   if (mm.width() != hm.width() || mm.height() != hm.height())
-    fail("skin_color_texture: melanin map {}x{} and hemoglobin map {}x{} differ", mm.width(), mm.height(), hm.width(),
-         hm.height());
+    fail("skin_color_texture: melanin map {}x{} and hemoglobin map {}x{} differ", mm.width(),
+         mm.height(), hm.width(), hm.height());
   image::ImageRGBF out(mm.width(), mm.height());
   for (int y = 0; y < mm.height(); ++y)
     for (int x = 0; x < mm.width(); ++x) {

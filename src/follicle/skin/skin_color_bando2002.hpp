@@ -13,16 +13,17 @@
 namespace follicle::skin {
 
 struct SkinColorParams {
-  Vec3 base{0.96, 0.84, 0.76};        // b (linear RGB)
-  Vec3 melanin_absorption{0.50, 0.58, 0.62};    // a_m
+  Vec3 base{0.96, 0.84, 0.76};                   // b (linear RGB)
+  Vec3 melanin_absorption{0.50, 0.58, 0.62};     // a_m
   Vec3 hemoglobin_absorption{0.02, 0.30, 0.22};  // a_h
-  double melanin = 0.1;    // m in [0, 1]
-  double hemoglobin = 0.3;  // h in [0, 1]
+  double melanin = 0.1;                          // m in [0, 1]
+  double hemoglobin = 0.3;                       // h in [0, 1]
   template <class V>
   void visit(V&& v) {
     v("base", base, ParamInfo{"base colour b", "", 0.0, 1.0});
     v("melanin_absorption", melanin_absorption, ParamInfo{"melanin absorption a_m", "", 0.0, 1.0});
-    v("hemoglobin_absorption", hemoglobin_absorption, ParamInfo{"hemoglobin absorption a_h", "", 0.0, 1.0});
+    v("hemoglobin_absorption", hemoglobin_absorption,
+      ParamInfo{"hemoglobin absorption a_h", "", 0.0, 1.0});
     v("melanin", melanin, ParamInfo{"amount of melanin m", "", 0.0, 1.0});
     v("hemoglobin", hemoglobin, ParamInfo{"amount of hemoglobin h", "", 0.0, 1.0});
   }

@@ -1,7 +1,6 @@
 #include "follicle/skin/skin_json.hpp"
 
 #include <nlohmann/json.hpp>
-
 #include <set>
 #include <type_traits>
 
@@ -61,7 +60,8 @@ struct Reader {
       out = T(v);
     } else if constexpr (std::is_same_v<T, Vec2> || std::is_same_v<T, Vec3>) {
       if (!j.is_array() || j.size() != std::size_t(out.size()))
-        bad(path, "expected an array of " + std::to_string(out.size()) + " numbers, got " + describe(j));
+        bad(path,
+            "expected an array of " + std::to_string(out.size()) + " numbers, got " + describe(j));
       for (int k = 0; k < out.size(); ++k) {
         out[k] = num(j[std::size_t(k)], path + "[" + std::to_string(k) + "]");
         range(path, out[k], info);
@@ -90,12 +90,13 @@ struct Reader {
   static void range(const std::string& path, double v, const ParamInfo& info) {
     if (!std::isfinite(v)) fail_at(path, "value is not finite");
     if (v < info.min || v > info.max)
-      fail_at(path, "value {} is out of range: expected {} in [{}, {}]{}", v, info.doc, info.min, info.max,
-              *info.unit ? std::string(" ") + info.unit : std::string());
+      fail_at(path, "value {} is out of range: expected {} in [{}, {}]{}", v, info.doc, info.min,
+              info.max, *info.unit ? std::string(" ") + info.unit : std::string());
   }
   template <class S>
   void read_struct(const Json& j, const std::string& path, S& s) const {
-    if (!j.is_object()) bad(path.empty() ? "(top level)" : path, "expected an object, got " + describe(j));
+    if (!j.is_object())
+      bad(path.empty() ? "(top level)" : path, "expected an object, got " + describe(j));
     std::vector<std::string> known;
     std::set<std::string> found;
     auto join = [&](const char* k) { return path.empty() ? std::string(k) : path + "." + k; };
@@ -116,12 +117,14 @@ struct Reader {
       const std::string d = did_you_mean(it.key(), known);
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      bad(join(it.key().c_str()), "unknown key" + (d.empty() ? std::string() : " (did you mean '" + d + "'?)") +
+      bad(join(it.key().c_str()), "unknown key" +
+                                      (d.empty() ? std::string() : " (did you mean '" + d + "'?)") +
                                       "; expected one of: " + list);
     }
     if constexpr (requires { S::kRequired; }) {
       for (const char* k : S::kRequired)
-        if (!j.contains(k)) bad(path.empty() ? "(top level)" : path, std::string("missing required key '") + k + "'");
+        if (!j.contains(k))
+          bad(path.empty() ? "(top level)" : path, std::string("missing required key '") + k + "'");
     }
   }
 };
@@ -151,7 +154,8 @@ struct Writer {
       return o;
     } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
       Json o = Json::object();
-      const_cast<T&>(v).visit([&](const char* name, auto& f, const ParamInfo& = {}) { o[name] = write(f); });
+      const_cast<T&>(v).visit(
+          [&](const char* name, auto& f, const ParamInfo& = {}) { o[name] = write(f); });
       return o;
     } else {
       return Json(v);
@@ -178,7 +182,8 @@ FaceSetup load_face_setup(const std::filesystem::path& path) {
   return face_setup_from_json_text(read_file(path), path.string());
 }
 
-std::vector<LargeWrinkle> wrinkles_from_json_text(const std::string& text, const std::string& file) {
+std::vector<LargeWrinkle> wrinkles_from_json_text(const std::string& text,
+                                                  const std::string& file) {
   const Json j = parse(text, file);
   std::vector<LargeWrinkle> w;
   Reader{file}.read(j, "wrinkles", w, ParamInfo{});
@@ -186,6 +191,8 @@ std::vector<LargeWrinkle> wrinkles_from_json_text(const std::string& text, const
   return w;
 }
 
-std::string face_setup_to_json(const FaceSetup& s) { return Writer::write(s).dump(2); }
+std::string face_setup_to_json(const FaceSetup& s) {
+  return Writer::write(s).dump(2);
+}
 
 }  // namespace follicle::skin

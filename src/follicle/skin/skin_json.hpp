@@ -27,9 +27,11 @@ struct FaceSetup {
   static constexpr const char* kRequired[] = {"follicle_face", "muscles"};
 };
 
-FaceSetup face_setup_from_json_text(const std::string& text, const std::string& file_for_errors = "");
+FaceSetup face_setup_from_json_text(const std::string& text,
+                                    const std::string& file_for_errors = "");
 FaceSetup load_face_setup(const std::filesystem::path& path);
-std::vector<LargeWrinkle> wrinkles_from_json_text(const std::string& text, const std::string& file_for_errors = "");
+std::vector<LargeWrinkle> wrinkles_from_json_text(const std::string& text,
+                                                  const std::string& file_for_errors = "");
 std::string face_setup_to_json(const FaceSetup& s);
 
 }  // namespace follicle::skin

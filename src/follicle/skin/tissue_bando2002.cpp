@@ -35,30 +35,37 @@ std::vector<double> initial_thickness(const TextureSpaceMesh& tex, const image::
   return h;
 }
 
-SubcutaneousTissue::SubcutaneousTissue(const geom::TriMesh& rest, const TextureSpaceMesh& tex, std::vector<double> h0)
+SubcutaneousTissue::SubcutaneousTissue(const geom::TriMesh& rest, const TextureSpaceMesh& tex,
+                                       std::vector<double> h0)
     : m_tex(&tex), m_h0(std::move(h0)) {
-  if (m_h0.size() != rest.positions.size()) fail("tissue: {} thickness values for {} vertices", m_h0.size(), rest.positions.size());
+  if (m_h0.size() != rest.positions.size())
+    fail("tissue: {} thickness values for {} vertices", m_h0.size(), rest.positions.size());
   m_rest_area.resize(rest.faces.size());
   for (std::size_t f = 0; f < rest.faces.size(); ++f) m_rest_area[f] = rest.face_area(f);
 }
 
-void SubcutaneousTissue::expansion(const Context& ctx, const std::vector<double>& area, std::vector<double>& e) const {
+void SubcutaneousTissue::expansion(const Context& ctx, const std::vector<double>& area,
+                                   std::vector<double>& e) const {
   e.resize(m_h0.size());
-  parallel_for(ctx, 0, m_h0.size(), [&](std::size_t i) {
-    double s = 0;
-    int n = 0;
-    for (std::size_t k = m_tex->vf_offsets[i]; k < m_tex->vf_offsets[i + 1]; ++k) {
-      const auto f = std::size_t(m_tex->vf_faces[k]);
-      if (m_rest_area[f] > 0) {
-        s += area[f] / m_rest_area[f];
-        ++n;
-      }
-    }
-    e[i] = n > 0 ? s / n : 1.0;  // e_i: mean area ratio of the incident triangles
-  }, 1024);
+  parallel_for(
+      ctx, 0, m_h0.size(),
+      [&](std::size_t i) {
+        double s = 0;
+        int n = 0;
+        for (std::size_t k = m_tex->vf_offsets[i]; k < m_tex->vf_offsets[i + 1]; ++k) {
+          const auto f = std::size_t(m_tex->vf_faces[k]);
+          if (m_rest_area[f] > 0) {
+            s += area[f] / m_rest_area[f];
+            ++n;
+          }
+        }
+        e[i] = n > 0 ? s / n : 1.0;  // e_i: mean area ratio of the incident triangles
+      },
+      1024);
 }
 
-void SubcutaneousTissue::offsets(const Context& ctx, const std::vector<double>& area, std::vector<double>& off) const {
+void SubcutaneousTissue::offsets(const Context& ctx, const std::vector<double>& area,
+                                 std::vector<double>& off) const {
   expansion(ctx, area, off);
   for (std::size_t i = 0; i < off.size(); ++i) {
     const double e = std::max(off[i], 1e-3);  // guard collapsed triangles

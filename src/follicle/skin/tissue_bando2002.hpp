@@ -21,7 +21,8 @@ struct TissueParams {
   void visit(V&& v) {
     v("enabled", enabled, ParamInfo{"apply the tissue layer", ""});
     v("max_thickness", max_thickness, ParamInfo{"thickness at white", "m", 0.0, 0.1});
-    v("default_thickness", default_thickness, ParamInfo{"uniform thickness without a map", "m", 0.0, 0.1});
+    v("default_thickness", default_thickness,
+      ParamInfo{"uniform thickness without a map", "m", 0.0, 0.1});
     v("thickness_map", thickness_map, ParamInfo{"grayscale thickness image (texture space)", ""});
   }
   void validate() const { validate_params(*this, "tissue"); }
@@ -36,11 +37,14 @@ std::vector<double> initial_thickness(const TextureSpaceMesh& tex, const image::
 
 class SubcutaneousTissue {
  public:
-  SubcutaneousTissue(const geom::TriMesh& rest, const TextureSpaceMesh& tex, std::vector<double> h0);
+  SubcutaneousTissue(const geom::TriMesh& rest, const TextureSpaceMesh& tex,
+                     std::vector<double> h0);
   /// Per-vertex expansion ratio e_i from the current face areas (`face_area`, one per face).
-  void expansion(const Context& ctx, const std::vector<double>& face_area, std::vector<double>& e) const;
+  void expansion(const Context& ctx, const std::vector<double>& face_area,
+                 std::vector<double>& e) const;
   /// Per-vertex normal offset h0/e - h0 [m].
-  void offsets(const Context& ctx, const std::vector<double>& face_area, std::vector<double>& off) const;
+  void offsets(const Context& ctx, const std::vector<double>& face_area,
+               std::vector<double>& off) const;
   const std::vector<double>& thickness() const { return m_h0; }
   const std::vector<double>& rest_areas() const { return m_rest_area; }
 

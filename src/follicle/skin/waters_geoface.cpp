@@ -82,7 +82,8 @@ WatersFace load_waters_geoface(const std::filesystem::path& dir, double s) {
       mirror[std::size_t(i)] = i;
     } else {
       mirror[std::size_t(i)] = int(out.mesh.positions.size());
-      out.mesh.positions.push_back(Vec3(-half[std::size_t(i)].x(), half[std::size_t(i)].y(), half[std::size_t(i)].z()));
+      out.mesh.positions.push_back(
+          Vec3(-half[std::size_t(i)].x(), half[std::size_t(i)].y(), half[std::size_t(i)].z()));
     }
   }
   Tokens ix(dir / "index.dat");
@@ -99,7 +100,8 @@ WatersFace load_waters_geoface(const std::filesystem::path& dir, double s) {
     std::array<int, 4> q{};
     for (auto& v : q) {
       v = ix.integer("a vertex index");
-      if (v != 1000 && (v < 1 || v > nv)) fail_at(ix.file(), "polygon {}: vertex index {} out of range [1, {}]", p + 1, v, nv);
+      if (v != 1000 && (v < 1 || v > nv))
+        fail_at(ix.file(), "polygon {}: vertex index {} out of range [1, {}]", p + 1, v, nv);
     }
     std::vector<std::array<int, 3>> tris;
     if (q[0] == 1000) {

@@ -20,8 +20,8 @@ inline double wrinkle_shape(double l, double depth, double width) {
 /// (2.4) M(s) = (1-r) s + r for s >= 0, r exp((1/r - 1) s) for s < 0. C1 at s = 0 for r in (0,1].
 /// r = 0 is the limit M = 0 for s < 0 (evaluated without dividing by r).
 inline double amplitude_modulation(double s, double r) {
-  if (s >= 0) return (1.0 - r) * s + r;  // (2.4) upper branch
-  if (r <= 0) return 0.0;                // limit r -> 0+: r exp((1/r-1)s) -> 0 for s < 0
+  if (s >= 0) return (1.0 - r) * s + r;      // (2.4) upper branch
+  if (r <= 0) return 0.0;                    // limit r -> 0+: r exp((1/r-1)s) -> 0 for s < 0
   return r * std::exp((1.0 / r - 1.0) * s);  // (2.4) lower branch
 }
 

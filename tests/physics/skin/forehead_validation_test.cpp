@@ -1,8 +1,9 @@
+#include "follicle/skin/forehead_validation.hpp"
+
 #include <gtest/gtest.h>
 
 #include "follicle/core/context.hpp"
 #include "follicle/geom/mesh_distance.hpp"
-#include "follicle/skin/forehead_validation.hpp"
 
 using namespace follicle;
 using namespace follicle::skin;
@@ -22,7 +23,8 @@ TEST(ForeheadValidation, GeneratedFurrowsMatchAnalyticProfile) {
   const auto rep = geom::mesh_distance(ctx, c.generated, c.reference, dp);
   RecordProperty("mean_mm", std::to_string(rep.two_sided.mean * 1e3));
   std::printf("forehead validation: two-sided mean %.4f mm, rms %.4f, p95 %.4f, max %.4f mm\n",
-              rep.two_sided.mean * 1e3, rep.two_sided.rms * 1e3, rep.two_sided.p95 * 1e3, rep.two_sided.max * 1e3);
+              rep.two_sided.mean * 1e3, rep.two_sided.rms * 1e3, rep.two_sided.p95 * 1e3,
+              rep.two_sided.max * 1e3);
   EXPECT_LT(rep.two_sided.mean, 0.1e-3);
   // And the unrefined coarse mesh is measurably worse (the refinement matters).
   ForeheadCaseParams coarse = p;

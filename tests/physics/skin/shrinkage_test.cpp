@@ -34,7 +34,8 @@ TEST(Shrinkage, RigidMotionGivesZeroShrinkageAndUnchangedWrinkles) {
   Patch p;
   WrinkleLayer layer(p.mesh, {p.w});
   ASSERT_GT(layer.influence(0).entries.size(), 100u);
-  const Affine3 xf = Eigen::Translation3d(0.1, -0.2, 0.3) * Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized());
+  const Affine3 xf =
+      Eigen::Translation3d(0.1, -0.2, 0.3) * Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized());
   std::vector<Vec3> moved = p.mesh.positions;
   for (auto& q : moved) q = xf * q;
   std::vector<double> s;
@@ -95,7 +96,6 @@ TEST(Shrinkage, OnlyAffectedVerticesRecomputedOnEdit) {
   EXPECT_EQ(layer.influence(1).entries.size(), before);
   EXPECT_DOUBLE_EQ(layer.wrinkle(0).depth, 0.001);
 }
-
 
 TEST(Shrinkage, PaperEdgeScalingAgreesWhenEdgesScaleAlike) {
   Context ctx(1);

@@ -1,10 +1,11 @@
+#include "follicle/geom/strand_io.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
 
 #include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
-#include "follicle/geom/strand_io.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
@@ -59,13 +60,16 @@ TEST(StrandIo, TfxRoundTripIsBitExact) {
     EXPECT_NEAR((r.points[r.strand_begin(h) + 7] - s.points[s.offsets[h + 1] - 1]).norm(), 0, 1e-7);
   }
   // A second write of the resampled set does not resample again: identical bytes.
-  EXPECT_EQ(serialize_tfx(strands_to_tfx(tfx_to_strands(parse_tfx(bytes, "x"), LengthUnit::m), LengthUnit::m, 8)), bytes);
+  EXPECT_EQ(serialize_tfx(strands_to_tfx(tfx_to_strands(parse_tfx(bytes, "x"), LengthUnit::m),
+                                         LengthUnit::m, 8)),
+            bytes);
   EXPECT_THROW(strands_to_tfx(s, LengthUnit::m, 12), Error);
 }
 
 TEST(StrandIo, SintelImports228By32) {
   FOLLICLE_REQUIRE_SHARED("sintel-lite-hair/GEO-sintel_hair_emit.001-sintel_hair.tfx");
-  const auto path = test::shared_data_dir() / "sintel-lite-hair/GEO-sintel_hair_emit.001-sintel_hair.tfx";
+  const auto path =
+      test::shared_data_dir() / "sintel-lite-hair/GEO-sintel_hair_emit.001-sintel_hair.tfx";
   const std::string bytes = read_file(path);
   const TfxFile f = parse_tfx(bytes, path.string());
   EXPECT_EQ(f.num_strands, 228u);
@@ -79,7 +83,8 @@ TEST(StrandIo, SintelImports228By32) {
   for (const auto& p : s.points) box.extend(p);
   EXPECT_NEAR(box.min().y(), 0.2072f, 1e-3f);
   EXPECT_NEAR(box.max().y(), 0.4769f, 1e-3f);
-  for (std::size_t h = 0; h < 228; ++h) EXPECT_EQ(f.positions[4 * 32 * h + 3], 0.0f);  // pinned roots
+  for (std::size_t h = 0; h < 228; ++h)
+    EXPECT_EQ(f.positions[4 * 32 * h + 3], 0.0f);  // pinned roots
 }
 
 TEST(StrandIo, MalformedFilesFailCleanly) {

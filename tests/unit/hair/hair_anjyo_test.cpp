@@ -56,7 +56,8 @@ TEST(Pores, RootsMoveToTheScalp) {
   PoreRegion r;
   r.zenith_max = 0.3;
   r.density = 2e4;
-  const HairRoots roots = sample_pores(ctx, sphere_hull(0.1), {r}, 1, brute_force_closest_point(plane));
+  const HairRoots roots =
+      sample_pores(ctx, sphere_hull(0.1), {r}, 1, brute_force_closest_point(plane));
   ASSERT_GT(roots.size(), 0u);
   for (const auto& p : roots.position) EXPECT_NEAR(p.y(), 0.05, 1e-12);
 }
@@ -209,7 +210,8 @@ TEST(StrandCache, RoundTripAndBadInput) {
 // a small CPU z-buffer (orthographic front and side views). Always checks the roots lie on the
 // scalp.
 TEST(HairPreview, PresetsOnTheDefaultHead) {
-  const auto mesh = geom::load_mesh(test::source_dir() / "data/meshes/lee_perry_smith/head.obj", LengthUnit::mm);
+  const auto mesh =
+      geom::load_mesh(test::source_dir() / "data/meshes/lee_perry_smith/head.obj", LengthUnit::mm);
   const sim::Ellipsoid hull = sim::fit_head_ellipsoid(mesh.positions);
   Context ctx(2, 1);
   const char* out_dir = std::getenv("FOLLICLE_HAIR_PREVIEW");
@@ -239,11 +241,15 @@ TEST(HairPreview, PresetsOnTheDefaultHead) {
       for (const auto& f : mesh.faces) {  // flat-shaded head
         double x[3], y[3], z[3];
         for (int c = 0; c < 3; ++c) proj(mesh.positions[std::size_t(f[c])], x[c], y[c], z[c]);
-        const Vec3 n = R * (mesh.positions[std::size_t(f[1])] - mesh.positions[std::size_t(f[0])])
-                               .cross(mesh.positions[std::size_t(f[2])] - mesh.positions[std::size_t(f[0])]);
-        const double sh = 0.25 + 0.7 * std::max(0.0, n.normalized().dot(Vec3(0.3, 0.5, 0.8).normalized()));
-        const int x0 = std::max(0, int(std::min({x[0], x[1], x[2]}))), x1 = std::min(W - 1, int(std::max({x[0], x[1], x[2]})) + 1);
-        const int y0 = std::max(0, int(std::min({y[0], y[1], y[2]}))), y1 = std::min(H - 1, int(std::max({y[0], y[1], y[2]})) + 1);
+        const Vec3 n =
+            R * (mesh.positions[std::size_t(f[1])] - mesh.positions[std::size_t(f[0])])
+                    .cross(mesh.positions[std::size_t(f[2])] - mesh.positions[std::size_t(f[0])]);
+        const double sh =
+            0.25 + 0.7 * std::max(0.0, n.normalized().dot(Vec3(0.3, 0.5, 0.8).normalized()));
+        const int x0 = std::max(0, int(std::min({x[0], x[1], x[2]}))),
+                  x1 = std::min(W - 1, int(std::max({x[0], x[1], x[2]})) + 1);
+        const int y0 = std::max(0, int(std::min({y[0], y[1], y[2]}))),
+                  y1 = std::min(H - 1, int(std::max({y[0], y[1], y[2]})) + 1);
         const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
         if (std::abs(area) < 1e-12) continue;
         for (int py = y0; py <= y1; ++py)
@@ -279,10 +285,12 @@ TEST(HairPreview, PresetsOnTheDefaultHead) {
             zr = zz;
             const Vec3f c = h.strands.color[i - 1] * float(1 - u) + h.strands.color[i] * float(u);
             uint8_t* pix = img.pixel(px, py);
-            for (int k = 0; k < 3; ++k) pix[k] = uint8_t(255 * std::pow(std::clamp(c[k], 0.f, 1.f), 1 / 2.2f));
+            for (int k = 0; k < 3; ++k)
+              pix[k] = uint8_t(255 * std::pow(std::clamp(c[k], 0.f, 1.f), 1 / 2.2f));
           }
         }
-      image::write_png(std::filesystem::path(out_dir) / (name + "_" + std::to_string(view) + ".png"), img);
+      image::write_png(
+          std::filesystem::path(out_dir) / (name + "_" + std::to_string(view) + ".png"), img);
     }
   }
 }

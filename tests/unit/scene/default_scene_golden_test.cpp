@@ -19,16 +19,17 @@ using namespace follicle;
 namespace {
 
 struct GoldenTolerance {
-  double max_rmse = 2.0;           // 8-bit levels
-  double min_psnr = 38.0;          // dB
-  double pixel_threshold = 32.0;   // a pixel is "off" when a channel differs by more
-  double max_share_over = 0.003;   // share of "off" pixels
+  double max_rmse = 2.0;          // 8-bit levels
+  double min_psnr = 38.0;         // dB
+  double pixel_threshold = 32.0;  // a pixel is "off" when a channel differs by more
+  double max_share_over = 0.003;  // share of "off" pixels
   template <class V>
   void visit(V&& v) {
     v("max_rmse", max_rmse, ParamInfo{"largest RMSE over RGB", "8-bit levels", 0.0, 255.0});
     v("min_psnr", min_psnr, ParamInfo{"smallest PSNR", "dB", 0.0, 200.0});
     v("pixel_threshold", pixel_threshold, ParamInfo{"per-channel difference", "", 0.0, 255.0});
-    v("max_share_over", max_share_over, ParamInfo{"share of pixels over the threshold", "", 0.0, 1.0});
+    v("max_share_over", max_share_over,
+      ParamInfo{"share of pixels over the threshold", "", 0.0, 1.0});
   }
 };
 
@@ -42,8 +43,7 @@ TEST(DefaultSceneGolden, MatchesWithinTolerance) {
   } catch (const Error& e) {
     GTEST_SKIP() << "no headless OpenGL 3.3: " << e.what();
   }
-  auto session =
-      scene::Session::load(test::source_dir() / "data" / "scenes" / "default.json", ctx);
+  auto session = scene::Session::load(test::source_dir() / "data" / "scenes" / "default.json", ctx);
   const auto img = renderer->render(session.render_scene(0), session.render_settings());
   ASSERT_EQ(img.width(), session.scene().render.width);
   ASSERT_EQ(img.height(), session.scene().render.height);
@@ -66,7 +66,8 @@ TEST(DefaultSceneGolden, MatchesWithinTolerance) {
   opt.threshold = tol.pixel_threshold;
   opt.ignore_alpha = true;
   const auto d = image::compare_images(img, golden, opt);
-  const bool ok = d.rmse <= tol.max_rmse && d.psnr >= tol.min_psnr && d.share_over <= tol.max_share_over;
+  const bool ok =
+      d.rmse <= tol.max_rmse && d.psnr >= tol.min_psnr && d.share_over <= tol.max_share_over;
   if (!ok) {
     const auto out = test::scratch_dir("golden") / "default_actual.png";
     image::write_png(out, img);

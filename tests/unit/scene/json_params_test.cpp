@@ -1,10 +1,11 @@
 // The strict JSON reader/writer/doc visitors on small parameter structs.
+#include "follicle/scene/json_params.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
 
-#include "follicle/scene/json_params.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
@@ -130,7 +131,8 @@ TEST(JsonReader, UnknownKeyNamesFilePathAndSuggestion) {
 TEST(JsonReader, WrongTypesSayWhatWasExpected) {
   EXPECT_THAT(error_of(R"({"speed": "fast"})"),
               HasSubstr("speed: expected a number, got a string \"fast\""));
-  EXPECT_THAT(error_of(R"({"count": 2.5})"), HasSubstr("count: expected an integer, got a number 2.5"));
+  EXPECT_THAT(error_of(R"({"count": 2.5})"),
+              HasSubstr("count: expected an integer, got a number 2.5"));
   EXPECT_THAT(error_of(R"({"enabled": 1})"), HasSubstr("enabled: expected true or false"));
   EXPECT_THAT(error_of(R"({"name": 3})"), HasSubstr("name: expected a string, got a number 3"));
   EXPECT_THAT(error_of(R"({"inner": [1]})"), HasSubstr("inner: expected an object, got an array"));
@@ -150,7 +152,8 @@ TEST(JsonReader, OutOfRangeNamesBoundAndUnit) {
   EXPECT_THAT(e, HasSubstr("test.json: speed: value 150 is out of range"));
   EXPECT_THAT(e, HasSubstr("[0, 100] m/s"));
   EXPECT_THAT(error_of(R"({"inner": {"stiffness": -1}})"), HasSubstr("inner.stiffness"));
-  EXPECT_THAT(error_of(R"({"weights": [0.5, 2]})"), HasSubstr("weights[1]: value 2 is out of range"));
+  EXPECT_THAT(error_of(R"({"weights": [0.5, 2]})"),
+              HasSubstr("weights[1]: value 2 is out of range"));
   EXPECT_THAT(error_of(R"({"count": 0})"), HasSubstr("count: value 0 is out of range"));
   EXPECT_THAT(error_of(R"({"maybe": 3})"), HasSubstr("maybe: value 3 is out of range"));
 }

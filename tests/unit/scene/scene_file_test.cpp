@@ -70,8 +70,7 @@ TEST(SceneFile, TransformAppliesScaleThenRotationThenTranslation) {
 }
 
 TEST(SceneFile, VersionIsCheckedFirst) {
-  EXPECT_THAT(error_of(R"({"camera": {}})"),
-              HasSubstr("missing required key \"follicle_scene\""));
+  EXPECT_THAT(error_of(R"({"camera": {}})"), HasSubstr("missing required key \"follicle_scene\""));
   EXPECT_THAT(error_of(R"({"follicle_scene": 2, "bogus": 1})"),
               HasSubstr("unsupported scene format version 2: this Follicle reads version 1"));
   EXPECT_THAT(error_of(R"({"follicle_scene": "1"})"), HasSubstr("expected the integer"));
@@ -100,8 +99,9 @@ TEST(SceneFile, StrictKeysWithPaths) {
 TEST(SceneFile, CrossFieldValidation) {
   EXPECT_THAT(error_of(R"({"follicle_scene": 1, "camera": {"near": 5, "far": 1}})"),
               HasSubstr("camera.far: far (1) must be greater than near (5)"));
-  EXPECT_THAT(error_of(R"({"follicle_scene": 1, "camera": {"eye": [1, 2, 3], "target": [1, 2, 3]}})"),
-              HasSubstr("camera.target"));
+  EXPECT_THAT(
+      error_of(R"({"follicle_scene": 1, "camera": {"eye": [1, 2, 3], "target": [1, 2, 3]}})"),
+      HasSubstr("camera.target"));
   EXPECT_THAT(error_of(R"({"follicle_scene": 1, "camera": {"up": [0, 0, -1]}})"),
               HasSubstr("camera.up: up vector is parallel"));
   EXPECT_THAT(error_of(R"({"follicle_scene": 1, "lights": [{"direction": [0, 0, 0]}]})"),

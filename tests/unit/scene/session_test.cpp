@@ -1,11 +1,12 @@
 // Session on the shipped default scene and on small scenes with their own meshes.
+#include "follicle/scene/session.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "follicle/geom/mesh_io.hpp"
-#include "follicle/scene/session.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;

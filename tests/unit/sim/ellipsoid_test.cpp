@@ -1,9 +1,10 @@
+#include "follicle/sim/ellipsoid.hpp"
+
 #include <gtest/gtest.h>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/rng.hpp"
 #include "follicle/geom/mesh_io.hpp"
-#include "follicle/sim/ellipsoid.hpp"
 #include "follicle/sim/step_report.hpp"
 #include "testing/testing.hpp"
 
@@ -48,7 +49,8 @@ TEST(Ellipsoid, PushOutAndClosestPoint) {
   const Ellipsoid e = test_ellipsoid();
   Rng rng(3);
   for (int k = 0; k < 200; ++k) {
-    const Vec3 p = e.centre + Vec3(rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2));
+    const Vec3 p =
+        e.centre + Vec3(rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2));
     const Vec3 q = e.push_out(p, 0.001);
     EXPECT_GE(e.value(q), -1e-12);
     const Vec3 c = e.closest_point(p);

@@ -1,7 +1,8 @@
+#include "follicle/skin/face_rig.hpp"
+
 #include <gtest/gtest.h>
 
 #include "follicle/core/context.hpp"
-#include "follicle/skin/face_rig.hpp"
 #include "follicle/skin/forehead_validation.hpp"
 #include "follicle/skin/skin_color_bando2002.hpp"
 #include "follicle/skin/skin_json.hpp"
@@ -46,14 +47,16 @@ TEST(FaceRig, NeutralIsRestAndExpressionWrinkles) {
   FaceState s;
   rig.update(ctx, rig.neutral_pose(), s);
   for (std::size_t i = 0; i < s.positions.size(); ++i)
-    EXPECT_LT((s.positions[i] - rig.rest_mesh().positions[i]).norm(), 1e-12);  // r = 0, no tissue change
+    EXPECT_LT((s.positions[i] - rig.rest_mesh().positions[i]).norm(),
+              1e-12);  // r = 0, no tissue change
   rig.update(ctx, rig.expression_pose("raise"), s);
   double hmin = 0;
   for (double h : s.wrinkle_height) hmin = std::min(hmin, h);
   EXPECT_LT(hmin, -1e-4);  // a furrow appears when the forehead compresses
   // Tissue lifts compressed skin outward (along +normal ~ radial).
   double lift = 0;
-  for (std::size_t i = 0; i < s.animated.size(); ++i) lift = std::max(lift, (s.animated[i] - s.muscle_pos[i]).norm());
+  for (std::size_t i = 0; i < s.animated.size(); ++i)
+    lift = std::max(lift, (s.animated[i] - s.muscle_pos[i]).norm());
   EXPECT_GT(lift, 1e-5);
   rig.set_wrinkles_enabled(false);
   FaceState s2;
@@ -77,14 +80,16 @@ TEST(SkinColor, PlaneModelAndPresets) {
   p.melanin = 0;
   p.hemoglobin = 0;
   EXPECT_EQ(skin_color(p), p.base);
-  const Vec3 light = skin_color(skin_color_preset("caucasian")), dark = skin_color(skin_color_preset("african"));
+  const Vec3 light = skin_color(skin_color_preset("caucasian")),
+             dark = skin_color(skin_color_preset("african"));
   EXPECT_LT(dark.sum(), light.sum());
   EXPECT_GT(light.x(), light.z());  // skin is red-dominant
   SkinColorParams q;
   q.melanin = 0.3;
   q.hemoglobin = 0.1;
   const Vec3 c = skin_color(q);
-  EXPECT_LT((c - (q.base - 0.3 * q.melanin_absorption - 0.1 * q.hemoglobin_absorption)).norm(), 1e-15);  // (2.6)
+  EXPECT_LT((c - (q.base - 0.3 * q.melanin_absorption - 0.1 * q.hemoglobin_absorption)).norm(),
+            1e-15);  // (2.6)
   EXPECT_THROW(skin_color_preset("caucasain"), Error);
 }
 
@@ -93,7 +98,8 @@ TEST(SkinJson, DefaultHeadSetupLoads) {
   EXPECT_EQ(s.muscles.linear.size(), 14u);
   EXPECT_EQ(s.muscles.sphincter.size(), 1u);
   EXPECT_EQ(s.wrinkles.size(), 10u);
-  for (const char* e : {"thinking", "smile", "troubled", "angry", "surprise", "raised_brows", "frown"})
+  for (const char* e :
+       {"thinking", "smile", "troubled", "angry", "surprise", "raised_brows", "frown"})
     EXPECT_NO_THROW(s.muscles.expression(e)) << e;
   // Round trip.
   const FaceSetup t = face_setup_from_json_text(face_setup_to_json(s), "roundtrip");
@@ -111,20 +117,26 @@ TEST(SkinJson, MalformedInputFailsCleanly) {
     return std::string("no error");
   };
   EXPECT_NE(msg("{ \"follicle_face\": 1, ").find("bad.json"), std::string::npos);  // syntax
-  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{"linaer":[]}})").find("did you mean 'linear'"), std::string::npos);
-  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{"linear":[{"name":"a","origin":[0,0],"insertion":[0,0,1]}]}})")
-                .find("muscles.linear[0].origin"),
+  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{"linaer":[]}})").find("did you mean 'linear'"),
             std::string::npos);
-  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{"linear":[{"name":"a","origin":[0,0,0],"insertion":[0,0,0.01],"zone":"wide"}]}})")
-                .find("expected a number"),
-            std::string::npos);
-  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{"linear":[{"name":"a","origin":[0,0,0]}]}})").find("insertion"),
+  EXPECT_NE(
+      msg(R"({"follicle_face":1,"muscles":{"linear":[{"name":"a","origin":[0,0],"insertion":[0,0,1]}]}})")
+          .find("muscles.linear[0].origin"),
+      std::string::npos);
+  EXPECT_NE(
+      msg(R"({"follicle_face":1,"muscles":{"linear":[{"name":"a","origin":[0,0,0],"insertion":[0,0,0.01],"zone":"wide"}]}})")
+          .find("expected a number"),
+      std::string::npos);
+  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{"linear":[{"name":"a","origin":[0,0,0]}]}})")
+                .find("insertion"),
             std::string::npos);  // missing required key
-  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{},"wrinkles":[{"p0":[0,0],"p1":[0,0],"p2":[0,0],"p3":[1,0],"r":2}]})")
-                .find("out of range"),
-            std::string::npos);
-  EXPECT_NE(msg(R"({"follicle_face":1,"muscles":{"expressions":[{"name":"x","contractions":{"nope":1}}]}})")
-                .find("unknown muscle 'nope'"),
-            std::string::npos);
+  EXPECT_NE(
+      msg(R"({"follicle_face":1,"muscles":{},"wrinkles":[{"p0":[0,0],"p1":[0,0],"p2":[0,0],"p3":[1,0],"r":2}]})")
+          .find("out of range"),
+      std::string::npos);
+  EXPECT_NE(
+      msg(R"({"follicle_face":1,"muscles":{"expressions":[{"name":"x","contractions":{"nope":1}}]}})")
+          .find("unknown muscle 'nope'"),
+      std::string::npos);
   EXPECT_THROW(wrinkles_from_json_text(R"([{"p0":[0,0]}])"), Error);
 }

@@ -9,7 +9,8 @@ using namespace follicle::skin;
 TEST(Refine, CrackFreeWithUvsAndParents) {
   const geom::TriMesh base = make_cylinder_patch(0.05, 0.04, 0.08, 0.004);
   LargeWrinkle w;
-  w.control = {Vec2(0.2, 0.3), Vec2(0.4, 0.45), Vec2(0.6, 0.35), Vec2(0.8, 0.5)};  // curved, oblique
+  w.control = {Vec2(0.2, 0.3), Vec2(0.4, 0.45), Vec2(0.6, 0.35),
+               Vec2(0.8, 0.5)};  // curved, oblique
   w.width = 0.002;
   RefineParams rp;
   rp.max_levels = 3;
@@ -24,7 +25,8 @@ TEST(Refine, CrackFreeWithUvsAndParents) {
   for (double x : u) EXPECT_DOUBLE_EQ(x, 2.0);
   for (std::size_t k = 0; k < r.parents.size(); ++k) {
     const auto& pr = r.parents[k];
-    const Vec3 mid = 0.5 * (r.mesh.positions[std::size_t(pr[0])] + r.mesh.positions[std::size_t(pr[1])]);
+    const Vec3 mid =
+        0.5 * (r.mesh.positions[std::size_t(pr[0])] + r.mesh.positions[std::size_t(pr[1])]);
     EXPECT_LT((r.mesh.positions[std::size_t(r.base_vertices) + k] - mid).norm(), 1e-15);
   }
   // Total area is preserved (flat midpoints on facets), orientation kept.
@@ -38,6 +40,7 @@ TEST(Refine, CrackFreeWithUvsAndParents) {
 TEST(Refine, DetectsTJunction) {
   geom::TriMesh m;
   m.positions = {Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(1, 1, 0), Vec3(1, 0, 0), Vec3(1, -1, 0)};
-  m.faces = {Vec3i(0, 1, 2), Vec3i(0, 4, 3), Vec3i(3, 4, 1)};  // vertex 3 splits edge 0-1 on one side only
+  m.faces = {Vec3i(0, 1, 2), Vec3i(0, 4, 3),
+             Vec3i(3, 4, 1)};  // vertex 3 splits edge 0-1 on one side only
   EXPECT_GT(count_t_junctions(m), 0);
 }

@@ -46,7 +46,8 @@ TEST(WatersMuscle, ContractionMovesTowardOriginInsideZoneOnly) {
   // Linear in the contraction.
   std::vector<Vec3> half;
   field.apply(ctx, MusclePose{{0.4}, 0.0}, m.positions, half);
-  for (std::size_t i = 0; i < out.size(); ++i) EXPECT_LT(((out[i] - m.positions[i]) - 2 * (half[i] - m.positions[i])).norm(), 1e-15);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    EXPECT_LT(((out[i] - m.positions[i]) - 2 * (half[i] - m.positions[i])).norm(), 1e-15);
 }
 
 TEST(WatersMuscle, JawRotatesOnlyJawRegion) {
@@ -85,7 +86,8 @@ TEST(WatersGeoface, LoadsMirroredFaceMusclesAndExpressions) {
   EXPECT_EQ(f.muscles.expressions.size(), 6u);
   // Front faces are counter-clockwise: normals near the nose tip point +z.
   double nz = 0;
-  for (std::size_t i = 0; i < f.mesh.faces.size(); ++i) nz += f.mesh.face_normal(i).z() * f.mesh.face_area(i);
+  for (std::size_t i = 0; i < f.mesh.faces.size(); ++i)
+    nz += f.mesh.face_normal(i).z() * f.mesh.face_area(i);
   EXPECT_GT(nz, 0.0);
   // Anger raises the corrugators; happiness pulls the mouth corners toward the zygomatic origins.
   const Expression& happy = f.muscles.expression("Happiness");
@@ -100,7 +102,8 @@ TEST(WatersGeoface, LoadsMirroredFaceMusclesAndExpressions) {
   double closer = 0;
   for (int i : field.influenced_vertices(0)) {
     ++moved;
-    closer += (f.mesh.positions[std::size_t(i)] - zl.origin).norm() - (out[std::size_t(i)] - zl.origin).norm();
+    closer += (f.mesh.positions[std::size_t(i)] - zl.origin).norm() -
+              (out[std::size_t(i)] - zl.origin).norm();
   }
   EXPECT_GT(moved, 5u);
   EXPECT_GT(closer, 0.0);
@@ -110,7 +113,8 @@ TEST(WatersGeoface, LoadsMirroredFaceMusclesAndExpressions) {
   for (const auto& e : f.muscles.expressions) {
     field.apply(ctx, pose_from_expression(f.muscles, e), f.mesh.positions, out);
     double maxd = 0;
-    for (std::size_t i = 0; i < out.size(); ++i) maxd = std::max(maxd, (out[i] - f.mesh.positions[i]).norm());
+    for (std::size_t i = 0; i < out.size(); ++i)
+      maxd = std::max(maxd, (out[i] - f.mesh.positions[i]).norm());
     EXPECT_GT(maxd, 1e-3) << e.name;
     EXPECT_LT(maxd, 0.05) << e.name;
   }

@@ -15,7 +15,9 @@ TEST(WrinkleShape, IntegratesToZero) {  // (2.2)
     const double L = 60 * w, h = L / n;
     for (int i = 0; i < n; ++i) {
       const double a = i * h, b = a + h;
-      sum += h / 6 * (wrinkle_shape(a, d, w) + 4 * wrinkle_shape(0.5 * (a + b), d, w) + wrinkle_shape(b, d, w));
+      sum += h / 6 *
+             (wrinkle_shape(a, d, w) + 4 * wrinkle_shape(0.5 * (a + b), d, w) +
+              wrinkle_shape(b, d, w));
     }
     EXPECT_NEAR(sum / (d * w), 0.0, 1e-9);
   }
@@ -68,7 +70,8 @@ TEST(TriangleShrinkage, MatchesGeometry) {  // (2.3)
   EXPECT_NEAR(triangle_shrinkage(1.0, 0.0, 0.5, 2.0), 0.5, 1e-15);  // along edge 2 only t2 matters
   EXPECT_NEAR(triangle_shrinkage(0.5, 0.5, 1.0, 1.0), 0.0, 1e-15);
   // Direct construction: e2 = (1,0), e3 = (0,1), d = (1,1)/2 hits the edge at (0.5,0.5);
-  // scaled edges (t2, t3) -> the line x/t2 + y/t3 = 1 meets the diagonal at x = y = 1/(1/t2 + 1/t3).
+  // scaled edges (t2, t3) -> the line x/t2 + y/t3 = 1 meets the diagonal at x = y = 1/(1/t2 +
+  // 1/t3).
   const double t2 = 0.6, t3 = 1.3;
   const double xL = 0.5, xLp = 1.0 / (1.0 / t2 + 1.0 / t3);
   EXPECT_NEAR(triangle_shrinkage(0.5, 0.5, t2, t3), 1 - xLp / xL, 1e-14);

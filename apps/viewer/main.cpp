@@ -1,0 +1,37 @@
+// follicle-viewer SCENE [--screenshot out.png [--frames N] [--with-ui]] [--size WxH]
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <exception>
+
+#include "follicle/core/error.hpp"
+#include "viewer_app.hpp"
+
+int main(int argc, char** argv) {
+  follicle::viewer::ViewerOptions opt;
+  CLI::App app{"follicle-viewer: interactive viewer for Follicle scene files", "follicle-viewer"};
+  std::string scene, screenshot;
+  app.add_option("scene", scene, "scene file (JSON)")->required()->check(CLI::ExistingFile);
+  app.add_option("--screenshot", screenshot,
+                 "batch mode: draw --frames frames, save the view to this PNG and exit");
+  app.add_option("--frames", opt.frames, "frames to draw before the batch screenshot")
+      ->check(CLI::Range(1, 100000));
+  app.add_flag("--with-ui", opt.screenshot_ui, "batch screenshot of the whole window with the panel");
+  app.add_option("--width", opt.width, "window width")->check(CLI::Range(400, 16384));
+  app.add_option("--height", opt.height, "window height")->check(CLI::Range(200, 16384));
+  app.add_option("-j,--threads", opt.threads, "CPU threads (0 = all)")->check(CLI::Range(0, 1024));
+  CLI11_PARSE(app, argc, argv);
+  opt.scene = scene;
+  opt.screenshot = screenshot;
+  if (!screenshot.empty() && !screenshot.ends_with(".png") && !screenshot.ends_with(".PNG")) {
+    fmt::print(stderr, "follicle-viewer: --screenshot must end in .png, got '{}'\n", screenshot);
+    return 2;
+  }
+  try {
+    return follicle::viewer::run_viewer(opt);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "follicle-viewer: {}\n", e.what());
+    return 1;
+  }
+}
