@@ -20,7 +20,7 @@ struct Particle {
   vec3 pos; float half_w;
   vec3 t; float half_l;
   vec3 color; float alpha;
-  float min_sin; float cast; float self; int item;
+  float min_sin; float casts; float selfs; int item;
 };
 
 Particle fetch_particle(int i) {
@@ -32,7 +32,7 @@ Particle fetch_particle(int i) {
   p.pos = a.xyz; p.half_w = a.w;
   p.t = b.xyz; p.half_l = b.w;
   p.color = c.rgb; p.alpha = c.a;
-  p.min_sin = d.x; p.cast = d.y; p.self = d.z; p.item = int(d.w + 0.5);
+  p.min_sin = d.x; p.casts = d.y; p.selfs = d.z; p.item = int(d.w + 0.5);
   return p;
 }
 
@@ -135,7 +135,7 @@ void main() {
   float s;
   vec3 w = billboard_corner(p, uLightTravel, gl_VertexID % 6, vUV, s);
   float vis = texelFetch(uIntensity, intensity_texel(i), 0).r;
-  vAlpha = min(1.0, p.alpha / s * uShadowOpacity[p.item]) * vis * p.cast;
+  vAlpha = min(1.0, p.alpha / s * uShadowOpacity[p.item]) * vis * p.casts;
   gl_Position = uLightVP * vec4(w, 1.0);
 }
 )";
@@ -173,7 +173,7 @@ void main() {
   float att = 1.0;
   if (uHasIntensity) {
     vec2 li = texelFetch(uIntensity, intensity_texel(i), 0).rg;
-    att = li.r * (p.self > 0.5 ? li.g : 1.0);
+    att = li.r * (p.selfs > 0.5 ? li.g : 1.0);
   }
   int m = p.item;
   vec3 T = p.t, E = -dp;

@@ -178,8 +178,12 @@ TEST(Shading, SpecularTermAndIntensity) {
   Context ctx(1, 1);
   shade_anjyo1992(ctx, s, p, Vec3(0.5, 100, 0), Vec3(0, 1, 0), 1);
   ASSERT_EQ(s.color.size(), 2u);
-  EXPECT_NEAR(s.color[0].x(), 0.1 + 0.3, 1e-4);  // H ≈ y ⟂ T = x
-  EXPECT_NEAR(s.color[0].z(), 0.025 + 0.3, 1e-4);
+  // Expected from (8) and (9) with the exact halfway vector at node 0 (T = +x).
+  const Vec3 H = (Vec3(0, 1, 0) + Vec3(0.5, 100, 0).normalized()).normalized();
+  const double phi = 0.3 * std::pow(1.0 - H.x() * H.x(), 0.5 * p.exponent);
+  EXPECT_NEAR(s.color[0].x(), 0.5 * 0.2 + phi, 1e-6);
+  EXPECT_NEAR(s.color[0].z(), 0.5 * 0.05 + phi, 1e-6);
+  EXPECT_GT(phi, 0.29);
 }
 
 TEST(StrandCache, RoundTripAndBadInput) {
