@@ -9,23 +9,11 @@
 #include "follicle/core/error.hpp"
 #include "follicle/geom/mesh_io.hpp"
 #include "follicle/skin/fine_wrinkles_bando2002.hpp"
+#include "workloads/data_path.hpp"
 #include "workloads/workload.hpp"
 
 namespace follicle::workloads {
 namespace {
-
-std::filesystem::path find_data(const std::filesystem::path& rel) {
-  if (const char* env = std::getenv("FOLLICLE_DATA_DIR"))
-    if (std::filesystem::exists(std::filesystem::path(env) / rel))
-      return std::filesystem::path(env) / rel;
-  std::filesystem::path p = std::filesystem::current_path();
-  for (int i = 0; i < 6; ++i) {
-    if (std::filesystem::exists(p / "data" / rel)) return p / "data" / rel;
-    if (!p.has_parent_path() || p.parent_path() == p) break;
-    p = p.parent_path();
-  }
-  fail("cannot find data/{} (run from the repository or set FOLLICLE_DATA_DIR)", rel.string());
-}
 
 /// Two default fields: keys on every 40th uv vertex, field 0 along u (m = 0.5), field 1 at 70
 /// degrees (m = 0.4).

@@ -8,6 +8,7 @@
 #include "follicle/geom/grid.hpp"
 #include "follicle/geom/mesh_io.hpp"
 #include "follicle/geom/spatial_embree.hpp"
+#include "workloads/data_path.hpp"
 #include "workloads/workload.hpp"
 
 namespace follicle::workloads {
@@ -16,21 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The default head: $FOLLICLE_SOURCE_DIR, the compile-time FOLLICLE_SOURCE_DIR if defined, or
-// the current directory and its parents.
-fs::path default_head_path() {
-  const fs::path rel = "data/meshes/lee_perry_smith/head.obj";
-  if (const char* s = std::getenv("FOLLICLE_SOURCE_DIR"); s && *s) return fs::path(s) / rel;
-#ifdef FOLLICLE_SOURCE_DIR
-  if (fs::exists(fs::path(FOLLICLE_SOURCE_DIR) / rel)) return fs::path(FOLLICLE_SOURCE_DIR) / rel;
-#endif
-  for (fs::path d = fs::current_path(); !d.empty(); d = d.parent_path()) {
-    if (fs::exists(d / rel)) return d / rel;
-    if (d == d.root_path()) break;
-  }
-  fail("cannot find the default head '{}': run from the repository or set FOLLICLE_SOURCE_DIR",
-       rel.string());
-}
+fs::path default_head_path() { return find_data("meshes/lee_perry_smith/head.obj"); }
 
 std::size_t size_of(const Sizes& s, const char* key, double lo) {
   const double v = s.at(key);

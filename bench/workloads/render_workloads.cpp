@@ -5,30 +5,13 @@
 #include "follicle/core/error.hpp"
 #include "follicle/render/framing.hpp"
 #include "follicle/render/renderer.hpp"
+#include "workloads/data_path.hpp"
 #include "workloads/workload.hpp"
 
 namespace follicle::workloads {
 namespace {
 
-/// data/meshes/lee_perry_smith: $FOLLICLE_DATA_DIR, else the first `data` folder found walking
-/// up from the working directory (the repository root or a build folder inside it).
-std::filesystem::path find_head_dir() {
-  const std::filesystem::path rel = "meshes/lee_perry_smith";
-  if (const char* env = std::getenv("FOLLICLE_DATA_DIR")) {
-    if (std::filesystem::exists(std::filesystem::path(env) / rel / "head.obj"))
-      return std::filesystem::path(env) / rel;
-  }
-  std::filesystem::path p = std::filesystem::current_path();
-  for (int i = 0; i < 6; ++i) {
-    if (std::filesystem::exists(p / "data" / rel / "head.obj")) return p / "data" / rel;
-    if (!p.has_parent_path() || p.parent_path() == p) break;
-    p = p.parent_path();
-  }
-  fail(
-      "render-head: cannot find data/{}/head.obj (run from the repository or set "
-      "FOLLICLE_DATA_DIR)",
-      rel.string());
-}
+std::filesystem::path find_head_dir() { return find_data("meshes/lee_perry_smith"); }
 
 class RenderHead final : public WorkloadInstance {
  public:
