@@ -10,3 +10,9 @@ FOLLICLE=build/release/apps/cli/follicle
 mkdir -p out
 "$FOLLICLE" render data/scenes/default.json -o out/default.png
 echo "demo: wrote out/default.png"
+# Anjyo 1992 hair: the bob (Fig. 3) at full density, and the wind-gust clip (Fig. 10) as MP4.
+"$FOLLICLE" render data/scenes/anjyo_bob.json -o out/anjyo-bob.png
+echo "demo: wrote out/anjyo-bob.png"
+"$FOLLICLE" animate data/scenes/anjyo_wind.json -o out/anjyo-wind-frames --mp4 out/anjyo-wind.mp4 \
+  --cache out/anjyo-wind-cache
+echo "demo: wrote out/anjyo-wind.mp4"

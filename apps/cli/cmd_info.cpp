@@ -1,11 +1,14 @@
-// follicle info FILE: a summary of a scene or mesh file (hair files come with the hair module).
+// follicle info FILE: a summary of a scene, mesh or hair strand file.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <filesystem>
 
 #include "commands.hpp"
 #include "follicle/geom/mesh_io.hpp"
+#include "follicle/geom/strand_io.hpp"
 #include "follicle/scene/session.hpp"
 
 namespace follicle::cli {
@@ -41,6 +44,42 @@ void mesh_info(const std::string& path, LengthUnit unit) {
   fmt::print("surface area: {:.6g} m^2\n", area);
 }
 
+void hair_info(const std::string& path, LengthUnit unit) {
+  const auto s = geom::load_strands(path, unit);
+  const double k = 1.0 / unit_to_metres(unit);
+  fmt::print("hair: {}\n", path);
+  fmt::print("units: {} (as declared with --units)\n", to_string(unit));
+  fmt::print("strands: {}\n", s.num_strands());
+  fmt::print("points: {}\n", s.num_points());
+  fmt::print("segments: {}\n",
+             s.num_points() - std::min<std::size_t>(s.num_points(), s.num_strands()));
+  if (s.num_points() == 0) return;
+  Eigen::AlignedBox3d box;
+  for (const auto& p : s.points) box.extend(p.cast<double>());
+  double lmin = 1e300, lmax = 0.0, lsum = 0.0;
+  std::size_t pmin = SIZE_MAX, pmax = 0;
+  for (std::size_t i = 0; i < s.num_strands(); ++i) {
+    double len = 0.0;
+    const uint32_t b = s.strand_begin(i), n = s.strand_size(i);
+    for (uint32_t j = 1; j < n; ++j)
+      len += (s.points[b + j] - s.points[b + j - 1]).cast<double>().norm();
+    lmin = std::min(lmin, len);
+    lmax = std::max(lmax, len);
+    lsum += len;
+    pmin = std::min<std::size_t>(pmin, n);
+    pmax = std::max<std::size_t>(pmax, n);
+  }
+  const Vec3 lo = box.min() * k, hi = box.max() * k;
+  fmt::print("points per strand: min {}, max {}\n", pmin, pmax);
+  fmt::print("bounds min: [{:.6g}, {:.6g}, {:.6g}] {}\n", lo.x(), lo.y(), lo.z(), to_string(unit));
+  fmt::print("bounds max: [{:.6g}, {:.6g}, {:.6g}] {}\n", hi.x(), hi.y(), hi.z(), to_string(unit));
+  fmt::print("strand length: min {:.6g}, mean {:.6g}, max {:.6g} {}\n", lmin * k,
+             lsum * k / double(std::max<std::size_t>(1, s.num_strands())), lmax * k,
+             to_string(unit));
+  fmt::print("radius: {}, colour: {}\n", s.radius.empty() ? "no" : "per point",
+             s.color.empty() ? "no" : "per point");
+}
+
 }  // namespace
 
 int run_info(const GlobalOptions& g, const InfoArgs& a) {
@@ -55,9 +94,13 @@ int run_info(const GlobalOptions& g, const InfoArgs& a) {
     mesh_info(a.file, parse_length_unit(a.units));
     return 0;
   }
+  if (ext == ".hair" || ext == ".tfx") {
+    hair_info(a.file, parse_length_unit(a.units));
+    return 0;
+  }
   fail_at(a.file,
-          "unknown file type '{}': expected a scene (.json) or a mesh (.obj, .ply, "
-          ".gltf, .glb)",
+          "unknown file type '{}': expected a scene (.json), a mesh (.obj, .ply, .gltf, .glb) or "
+          "hair (.hair, .tfx)",
           ext);
 }
 

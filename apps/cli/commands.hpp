@@ -64,6 +64,26 @@ struct BenchArgs {
 };
 int run_bench(const GlobalOptions& g, const BenchArgs& a);
 
+struct ExportArgs {
+  std::string scene;
+  std::string hair;  // output strand file (.hair, .tfx, .usda, .obj)
+  int frame = 0;
+  std::string units = "m";
+  std::string cache;  // strand cache folder, "" = none
+};
+int run_export(const GlobalOptions& g, const ExportArgs& a);
+
+struct AnimateArgs {
+  std::string scene;
+  std::string frames;  // "A-B", "" = every frame of the scene
+  std::string output_dir;
+  std::string mp4;    // "" = DIR/<scene name>.mp4
+  std::string cache;  // strand cache folder, "" = none
+  bool no_video = false;
+  int width = 0, height = 0;
+};
+int run_animate(const GlobalOptions& g, const AnimateArgs& a);
+
 struct DocsArgs {
   std::string topic;   // "scene-format"
   std::string write;   // file to update in place, "" = print the tables

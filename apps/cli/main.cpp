@@ -54,9 +54,11 @@ int main(int argc, char** argv) {
   validate->add_option("scenes", va.scenes, "scene files (.json)")->required();
 
   InfoArgs ia;
-  auto* info = app.add_subcommand("info", "summarize a scene or mesh file");
-  info->add_option("file", ia.file, "scene (.json) or mesh (.obj, .ply, .gltf, .glb)")->required();
-  info->add_option("--units", ia.units, "length unit of a mesh file: mm, cm, dm, m")
+  auto* info = app.add_subcommand("info", "summarize a scene, mesh or hair file");
+  info->add_option("file", ia.file,
+                   "scene (.json), mesh (.obj, .ply, .gltf, .glb) or hair (.hair, .tfx)")
+      ->required();
+  info->add_option("--units", ia.units, "length unit of a mesh or hair file: mm, cm, dm, m")
       ->capture_default_str();
 
   ConvertArgs ca;
@@ -76,6 +78,29 @@ int main(int argc, char** argv) {
   bench->add_flag("--list", ba.list, "list the workloads with their default sizes");
   bench->add_option("--min-seconds", ba.min_seconds, "minimum timed duration per workload")
       ->capture_default_str();
+
+  ExportArgs ea;
+  auto* exp = app.add_subcommand("export", "write a scene's hair to a strand file");
+  exp->add_option("scene", ea.scene, "scene file (.json)")->required();
+  exp->add_option("--hair", ea.hair, "output strand file: .hair, .tfx, .usda or .obj")->required();
+  exp->add_option("--frame", ea.frame, "frame of the animation")->check(CLI::NonNegativeNumber);
+  exp->add_option("--units", ea.units, "length unit written to the file: mm, cm, dm, m")
+      ->capture_default_str();
+  exp->add_option("--cache", ea.cache, "strand cache folder (reuse simulated frames)");
+
+  AnimateArgs aa;
+  auto* animate = app.add_subcommand("animate", "render an animation to numbered PNGs and an MP4");
+  animate->add_option("scene", aa.scene, "scene file (.json) with an \"animation\" section")
+      ->required();
+  animate->add_option("--frames", aa.frames, "frame range A-B (default: every frame)");
+  animate->add_option("-o,--output", aa.output_dir, "output folder for frame_NNNN.png")->required();
+  animate->add_option("--mp4", aa.mp4, "MP4 file (default: DIR/<scene>.mp4)");
+  animate->add_option("--cache", aa.cache, "strand cache folder: re-render without re-simulating");
+  animate->add_flag("--no-video", aa.no_video, "write only the PNG frames");
+  animate->add_option("--width", aa.width, "image width in pixels (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  animate->add_option("--height", aa.height, "image height in pixels (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
 
   DocsArgs da;
   auto* docs = app.add_subcommand("docs", "");  // hidden: an empty group hides it from --help
@@ -99,6 +124,8 @@ int main(int argc, char** argv) {
     if (*convert) return run_convert(g, ca);
     if (*bench) return run_bench(g, ba);
     if (*docs) return run_docs(g, da);
+    if (*exp) return run_export(g, ea);
+    if (*animate) return run_animate(g, aa);
     return report("no command given (run 'follicle --help')", 2);
   } catch (const UsageError& e) {
     return report(e.what(), 2);

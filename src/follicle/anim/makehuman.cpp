@@ -253,11 +253,37 @@ SubMesh extract_hand(const MakeHumanBase& base, const Skeleton& skel, const Skin
     for (std::size_t v = 0; v < in.size(); ++v)
       if (in[v] && find(int(v)) != best) in[v] = 0;
   }
+  // Keep only the faces of the largest UV island: a face selected by its weights may belong to
+  // another chart of the atlas (hm08 has one wrist face whose UVs lie at v = 0.83, far from the
+  // hand island at v < 0.2); its UVs would stretch the bounding box used for the rescale below
+  // and shrink the hand to a small part of the texture.
+  std::vector<char> face_in(base.faces.size(), 0);
+  {
+    std::vector<int> parent(base.uvs.size());
+    for (std::size_t t = 0; t < parent.size(); ++t) parent[t] = int(t);
+    auto find = [&](int a) {
+      while (parent[a] != a) a = parent[a] = parent[parent[a]];
+      return a;
+    };
+    for (std::size_t f = 0; f < base.faces.size(); ++f) {
+      const Vec3i& F = base.faces[f];
+      if (!in[F[0]] || !in[F[1]] || !in[F[2]]) continue;
+      face_in[f] = 1;
+      const Vec3i& T = base.uv_faces[f];
+      for (int c = 1; c < 3; ++c) parent[find(T[c])] = find(T[0]);
+    }
+    std::vector<int> count(parent.size(), 0);
+    for (std::size_t f = 0; f < base.faces.size(); ++f)
+      if (face_in[f]) ++count[find(base.uv_faces[f][0])];
+    const int best = int(std::max_element(count.begin(), count.end()) - count.begin());
+    for (std::size_t f = 0; f < base.faces.size(); ++f)
+      if (face_in[f] && find(base.uv_faces[f][0]) != best) face_in[f] = 0;
+  }
   SubMesh out;
   std::vector<int> pos_new(base.positions.size(), -1), uv_new(base.uvs.size(), -1);
   for (std::size_t f = 0; f < base.faces.size(); ++f) {
     const Vec3i& F = base.faces[f];
-    if (!in[F[0]] || !in[F[1]] || !in[F[2]]) continue;
+    if (!face_in[f]) continue;
     Vec3i nf, nt;
     for (int c = 0; c < 3; ++c) {
       int& p = pos_new[F[c]];

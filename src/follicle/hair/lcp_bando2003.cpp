@@ -5,12 +5,18 @@
 #include <numeric>
 #include <unordered_map>
 
+#include <spdlog/spdlog.h>
+
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
 #include "follicle/core/rng.hpp"
 #include "follicle/hair/sph_kernel.hpp"
 
 namespace follicle::hair {
+
+namespace {
+constexpr double kOrphanAlignment = 0.1;  // a_ij floor of a forced root-side connection
+}  // namespace
 
 void LcpInitParams::validate() const {
   validate_params(*this, "lcp_init");
@@ -77,28 +83,11 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
     m.root[i] = uvs[i].z() < 0 ? 1 : 0;
   }
   const auto& t = m.rest_t;
-  // Mean nearest-neighbour distance sets h_s and h.
-  ParticleGrid grid;
-  const double search = 3.0 * p.spacing;
-  grid.build(x, search);
-  std::vector<double> nn(n, 0.0);
-  parallel_for(ctx, 0, n, [&](std::size_t i) {
-    double best = search * search;
-    grid.for_each_candidate(x[i], [&](uint32_t j) {
-      if (j != i) best = std::min(best, (x[j] - x[i]).squaredNorm());
-    });
-    nn[i] = best < search * search ? std::sqrt(best) : 0.0;
-  });
-  double sum = 0;
-  std::size_t cnt = 0;
-  for (double d : nn)
-    if (d > 0) {
-      sum += d;
-      ++cnt;
-    }
-  if (cnt == 0 || !(sum > 0))
-    fail_at("lcp_init.spacing", "no particle has a neighbour within 3 x spacing = {} m", search);
-  m.spacing = sum / double(cnt);
+  // h_s and h are set from the Poisson-disc radius r, the intended inter-particle distance of
+  // §3.3.1 ("a little larger/smaller than the initial average inter-particle distance"). The
+  // measured mean nearest-neighbour distance is NOT used: where the initial hair shape makes
+  // strands converge (hanging hair) it shrinks and would leave sparser particles unconnected.
+  m.spacing = p.spacing;
   m.h_s = p.hs_factor * m.spacing;
   m.h = p.h_factor * m.spacing;
 
@@ -157,6 +146,34 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
         c.strength = c.c * sph_w(m.h_s, c.l0);
         cands.push_back(c);
       }
+  }
+  {
+    // A particle that still has no root-side partner (its neighbours within 2 h_s all lie beside
+    // it) is tied to the nearest neighbour with a smaller arc length s, with a small alignment
+    // floor, so that every particle starts attached to the head (not in the paper).
+    std::vector<char> has_root_side(n, 0);
+    for (const auto& c : cands) has_root_side[c.b] = 1;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (m.root[i] || has_root_side[i]) continue;
+      double best = 4 * m.h_s * m.h_s;
+      uint32_t bj = uint32_t(-1);
+      for (uint32_t q = off[i]; q < off[i + 1]; ++q) {
+        const uint32_t j = nb[q];
+        const double d2 = (x[j] - x[i]).squaredNorm();
+        if (uvs[j].z() < uvs[i].z() && d2 < best && d2 > 0) {
+          best = d2;
+          bj = j;
+        }
+      }
+      if (bj == uint32_t(-1)) continue;
+      const Vec3 d = x[i] - x[bj];
+      const double l0 = d.norm();
+      const Vec3 xh = d / l0;
+      const double a = std::max(std::abs((t[bj].dot(xh) + t[i].dot(xh)) / 2), kOrphanAlignment);
+      Cand c{bj, uint32_t(i), l0, a * l0, t[bj].dot(xh), t[i].dot(xh), 0};
+      c.strength = c.c * sph_w(m.h_s, l0);
+      cands.push_back(c);
+    }
   }
   // Remove the weakest connections while both ends keep more than N_n (never a tip-side end's
   // last root-side connection).
@@ -270,6 +287,31 @@ Chain cantilever_chain(const ScalpPoint& sp, const Vec3& tr, double L, double s,
 
 }  // namespace
 
+std::vector<char> lcp_attached(const LcpModel& m) {
+  const std::size_t n = m.size();
+  std::vector<char> att(n, 0);
+  std::vector<uint32_t> stack;
+  for (std::size_t i = 0; i < n; ++i)
+    if (m.root[i]) {
+      att[i] = 1;
+      stack.push_back(uint32_t(i));
+    }
+  while (!stack.empty()) {
+    const uint32_t i = stack.back();
+    stack.pop_back();
+    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+      const uint32_t q = m.adj_pairs[e];
+      if (m.pair_a[q] != i) continue;  // follow root-side -> tip-side only
+      const uint32_t b = m.pair_b[q];
+      if (!att[b]) {
+        att[b] = 1;
+        stack.push_back(b);
+      }
+    }
+  }
+  return att;
+}
+
 LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitParams& p,
                        const sim::VoxelPlanes* body) {
   p.validate();
@@ -339,11 +381,33 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
     t[i] = c.t;
     uvs[i] = Vec3(q.uv.x(), q.uv.y(), q.s);
   });
+  // Particles that cannot reach a root particle through root-side connections would fall off
+  // the head; they are removed (iterated, as removal may cut others off) and the mass shared
+  // again. Not in the paper, which does not say how isolated particles are treated.
   LcpInit out;
-  out.model = connect_particles(ctx, x, t, uvs, mass, p);
+  for (int pass = 0;; ++pass) {
+    out.model = connect_particles(ctx, x, t, uvs, mass, p);
+    const std::vector<char> att = lcp_attached(out.model);
+    const std::size_t nkeep = std::size_t(std::count(att.begin(), att.end(), char(1)));
+    if (nkeep == x.size() || pass >= 8) break;
+    if (nkeep < 2) fail_at("lcp_init", "no particle is connected to a root particle");
+    std::vector<Vec3> x2, t2, uvs2;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (att[i]) {
+        x2.push_back(x[i]);
+        t2.push_back(t[i]);
+        uvs2.push_back(uvs[i]);
+      }
+    ctx.log().info("lcp: removed {} particle(s) not connected to the head", x.size() - nkeep);
+    x = std::move(x2);
+    t = std::move(t2);
+    uvs = std::move(uvs2);
+    mass.assign(x.size(), p.total_mass / double(x.size()));
+  }
+  const std::size_t n2 = x.size();
   out.state.x = out.model.rest_x;
   out.state.t = out.model.rest_t;
-  out.state.v.assign(n, Vec3::Zero());
+  out.state.v.assign(n2, Vec3::Zero());
   return out;
 }
 

@@ -181,6 +181,10 @@ struct LcpInit {
 LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitParams& p,
                        const sim::VoxelPlanes* body = nullptr);
 
+/// 1 for root particles and for every particle reachable from one through root-side -> tip-side
+/// connections (i.e. held by the head), 0 otherwise.
+std::vector<char> lcp_attached(const LcpModel& model);
+
 /// (3.4) root direction t_r(u, v) (not normalised) for the whirl normal n_w.
 Vec3 root_direction(const Vec3& n_w, const Vec3& n, double w_t, double w_n);
 

@@ -117,15 +117,15 @@ enum class ParticleShading {
 /// where cos(theta) = t_i . d_p, and shaded by the Kajiya-Kay phase function times Goldman's
 /// directionality factor f_dir = (1+kappa)/2 reflect + (1-kappa)/2 transmit.
 struct SplatMaterial {
-  double diffuse = 0.8;         // Kajiya-Kay K_d
-  double specular = 0.25;       // Kajiya-Kay K_s
-  double shininess = 30.0;      // Kajiya-Kay exponent p
-  double ambient = 0.12;        // ambient factor (times RenderScene::ambient_color)
-  double reflect = 1.0;         // Goldman rho_reflect (eye on the lit side, kappa = +1)
-  double transmit = 0.35;       // Goldman rho_transmit (back-lit, kappa = -1)
-  double length_scale = 3.0;    // billboard half-length along t_i, in particle radii
-  double width_scale = 1.0;     // billboard half-width across t_i, in particle radii
-  double min_sin_theta = 0.25;  // clamp of sin(theta) in the 1/sin(theta) opacity rule
+  double diffuse = 0.8;               // Kajiya-Kay K_d
+  double specular = 0.25;             // Kajiya-Kay K_s
+  double shininess = 30.0;            // Kajiya-Kay exponent p
+  double ambient = 0.12;              // ambient factor (times RenderScene::ambient_color)
+  double reflect = 1.0;               // Goldman rho_reflect (eye on the lit side, kappa = +1)
+  double transmit = 0.35;             // Goldman rho_transmit (back-lit, kappa = -1)
+  double length_scale = 3.0;          // billboard half-length along t_i, in particle radii
+  double width_scale = 1.0;           // billboard half-width across t_i, in particle radii
+  double min_sin_theta = 0.25;        // clamp of sin(theta) in the 1/sin(theta) opacity rule
   double shadow_opacity_scale = 1.0;  // opacity multiplier in the light-view pass
   bool self_shadow = true;  // particles read the light attenuated by the hair nearer the light
   bool cast_shadow = true;  // particles attenuate light for other particles and for the meshes

@@ -206,6 +206,7 @@ flat in float vAlpha;
 out vec4 fragColor;
 void main() {
   vec4 tx = texture(uHairTex, vUV);
+  if (tx.a < 0.004) discard;  // most of a hair billboard is empty: skip the blend
   fragColor = vec4(vColor * tx.rgb, vAlpha * tx.a);
 }
 )";

@@ -57,13 +57,13 @@ image::ImageRGBA8 make_hair_texture(int width, int height, int strands, uint64_t
   for (int k = 0; k < strands; ++k) {
     Rng r = Rng::stream(seed, uint64_t(k));
     Streak s{};
-    s.x = r.uniform(0.2, 0.8);           // centre across, in [0,1] of the width
-    s.sigma = r.uniform(0.012, 0.028);   // cross-section (a pixel or two at 64 px)
-    s.slope = r.uniform(-0.06, 0.06);    // slight tilt against the axis
-    s.alpha = r.uniform(0.55, 1.0);      // coverage at the centre of the streak
-    s.bright = r.uniform(0.6, 1.0);      // brightness variation between fibres
-    s.v0 = r.uniform(0.0, 0.25);         // fades in ...
-    s.v1 = r.uniform(0.75, 1.0);         // ... and out along the length
+    s.x = r.uniform(0.2, 0.8);          // centre across, in [0,1] of the width
+    s.sigma = r.uniform(0.012, 0.028);  // cross-section (a pixel or two at 64 px)
+    s.slope = r.uniform(-0.06, 0.06);   // slight tilt against the axis
+    s.alpha = r.uniform(0.55, 1.0);     // coverage at the centre of the streak
+    s.bright = r.uniform(0.6, 1.0);     // brightness variation between fibres
+    s.v0 = r.uniform(0.0, 0.25);        // fades in ...
+    s.v1 = r.uniform(0.75, 1.0);        // ... and out along the length
     streaks.push_back(s);
   }
   image::ImageRGBA8 img(width, height);
@@ -171,23 +171,23 @@ RenderScene make_hair_sheet_scene(int particles, uint64_t seed, double radius) {
   ParticleItem hair;
   hair.particles = ps;
   hair.shading = ParticleShading::HairSplat;
-  hair.color = Vec3(0.30, 0.17, 0.08);
+  hair.color = Vec3(0.20, 0.105, 0.05);
   hair.radius = radius;
-  hair.opacity = 0.55;
+  hair.opacity = 0.7;
   sc.particles.push_back(hair);
 
   DirectionalLight key;
-  key.direction = Vec3(-0.6, -0.7, -0.35);
-  key.intensity = 2.2;
+  key.direction = Vec3(-0.75, -0.6, 0.25);
+  key.intensity = 2.0;
   sc.lights.push_back(key);
   DirectionalLight fill;
-  fill.direction = Vec3(0.7, -0.2, 0.6);
-  fill.intensity = 0.35;
+  fill.direction = Vec3(0.6, -0.3, 0.6);
+  fill.intensity = 0.3;
   fill.cast_shadow = false;
   sc.lights.push_back(fill);
-  sc.ambient_color = Vec3(0.5, 0.5, 0.55);
+  sc.ambient_color = Vec3(0.35, 0.35, 0.4);
   sc.background = Vec3(0.55, 0.6, 0.65);
-  sc.camera.eye = Vec3(0.42, 0.06, -0.3);
+  sc.camera.eye = Vec3(-0.25, 0.08, -0.45);
   sc.camera.target = Vec3(0, -0.03, 0);
   sc.camera.fov_y = 0.75;
   sc.camera.z_near = 0.05;

@@ -49,7 +49,7 @@ image::ImageRGBA8 make_hair_texture(int width = 64, int height = 128, int strand
 /// Blinn-Phong) with about `particles` hair particles (radius `radius`) along strands that
 /// start on the crown and back of the head, follow the sphere down to its equator and hang
 /// straight down (a sheet 4-25 mm thick), directions t_i along the strands; one key light with
-/// shadows from the upper right-front and a weak fill light; a camera from the side-back.
+/// shadows from the upper left-back, a weak fill light and a camera behind the head.
 /// particles[0] is the HairSplat item, meshes[0] the head. Deterministic for a seed; throws
 /// follicle::Error for particles < 1.
 RenderScene make_hair_sheet_scene(int particles = 2000, uint64_t seed = 1, double radius = 0.006);

@@ -35,8 +35,8 @@ void check_gl(const char* what) {
   if (e != GL_NO_ERROR) fail("render: OpenGL error 0x{:x} during {}", unsigned(e), what);
 }
 
-GLuint make_2d_texture(GLenum internal, int w, int h, GLenum format, GLenum type,
-                       const void* data, GLenum filter) {
+GLuint make_2d_texture(GLenum internal, int w, int h, GLenum format, GLenum type, const void* data,
+                       GLenum filter) {
   GLuint t = 0;
   glGenTextures(1, &t);
   glBindTexture(GL_TEXTURE_2D, t);
@@ -52,8 +52,8 @@ GLuint make_2d_texture(GLenum internal, int w, int h, GLenum format, GLenum type
 
 GLuint upload_hair_texture(const image::ImageRGBA8& img) {
   if (img.empty()) fail("render: empty hair texture");
-  const GLuint t = make_2d_texture(GL_RGBA8, img.width(), img.height(), GL_RGBA,
-                                   GL_UNSIGNED_BYTE, img.data(), GL_LINEAR_MIPMAP_LINEAR);
+  const GLuint t = make_2d_texture(GL_RGBA8, img.width(), img.height(), GL_RGBA, GL_UNSIGNED_BYTE,
+                                   img.data(), GL_LINEAR_MIPMAP_NEAREST);
   glGenerateMipmap(GL_TEXTURE_2D);
   return t;
 }
@@ -98,8 +98,8 @@ SplatPassGl::SplatPassGl() {
 SplatPassGl::~SplatPassGl() {
   for (GLuint p : {m_gather_prog, m_light_prog, m_view_prog}) glDeleteProgram(p);
   for (GLuint b : {m_particle_buf, m_order_buf}) glDeleteBuffers(1, &b);
-  for (GLuint t : {m_particle_tbo, m_order_tbo, m_intensity_tex, m_light_tex, m_default_tex,
-                   m_custom_tex})
+  for (GLuint t :
+       {m_particle_tbo, m_order_tbo, m_intensity_tex, m_light_tex, m_default_tex, m_custom_tex})
     if (t) glDeleteTextures(1, &t);
   for (GLuint f : {m_intensity_fbo, m_light_fbo})
     if (f) glDeleteFramebuffers(1, &f);
@@ -200,8 +200,7 @@ void SplatPassGl::prepare(const RenderScene& scene, Eigen::AlignedBox3d* shadow_
     glBufferData(GL_TEXTURE_BUFFER, GLsizeiptr(m_particle_cap * sizeof(float)), nullptr,
                  GL_DYNAMIC_DRAW);
   }
-  glBufferSubData(GL_TEXTURE_BUFFER, 0, GLsizeiptr(m_data.size() * sizeof(float)),
-                  m_data.data());
+  glBufferSubData(GL_TEXTURE_BUFFER, 0, GLsizeiptr(m_data.size() * sizeof(float)), m_data.data());
   glBindTexture(GL_TEXTURE_BUFFER, m_particle_tbo);
   glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, m_particle_buf);
   glBindBuffer(GL_TEXTURE_BUFFER, m_order_buf);
@@ -240,8 +239,8 @@ void SplatPassGl::ensure_intensity(std::size_t n) {
   if (m_intensity_tex) glDeleteTextures(1, &m_intensity_tex);
   m_intensity_w = std::max(w, m_intensity_w);
   m_intensity_h = std::max(h, m_intensity_h);
-  m_intensity_tex = make_2d_texture(GL_RG32F, m_intensity_w, m_intensity_h, GL_RG, GL_FLOAT,
-                                    nullptr, GL_NEAREST);
+  m_intensity_tex =
+      make_2d_texture(GL_RG32F, m_intensity_w, m_intensity_h, GL_RG, GL_FLOAT, nullptr, GL_NEAREST);
   m_intensity_fbo = make_fbo(m_intensity_tex, "hair intensity");
 }
 
@@ -268,8 +267,7 @@ void SplatPassGl::bind_common(GLuint prog, int order_base) {
   gl::set_i(prog, "uIntensityWidth", m_intensity_w > 0 ? m_intensity_w : 1);
 }
 
-void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
-                             GLuint empty_vao) {
+void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao) {
   m_light_done = false;
   if (m_count == 0) return;
   const std::size_t n = m_count;
@@ -369,8 +367,8 @@ void SplatPassGl::view_pass(const RenderScene& scene, const Mat4& view, const Ma
   std::stable_sort(order.begin(), order.end(),
                    [&](int32_t a, int32_t b) { return z[std::size_t(a)] < z[std::size_t(b)]; });
   glBindBuffer(GL_TEXTURE_BUFFER, m_order_buf);
-  glBufferSubData(GL_TEXTURE_BUFFER, GLintptr(n * sizeof(int32_t)),
-                  GLsizeiptr(n * sizeof(int32_t)), order.data());
+  glBufferSubData(GL_TEXTURE_BUFFER, GLintptr(n * sizeof(int32_t)), GLsizeiptr(n * sizeof(int32_t)),
+                  order.data());
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
 
   glActiveTexture(GL_TEXTURE0 + kUnitParticles);

@@ -34,10 +34,10 @@ class SplatPassGl {
   bool empty() const { return m_count == 0; }
 
   struct Light {
-    int index = -1;          // light of the light pass (the renderer's shadow light)
-    Vec3 travel{0, 0, -1};   // unit direction the light travels
+    int index = -1;         // light of the light pass (the renderer's shadow light)
+    Vec3 travel{0, 0, -1};  // unit direction the light travels
     Mat4 light_vp = Mat4::Identity();
-    GLuint shadow_tex = 0;   // objects' depth map (compare mode), over the same light_vp
+    GLuint shadow_tex = 0;  // objects' depth map (compare mode), over the same light_vp
     double shadow_texel = 0, shadow_bias = 0;
   };
   /// Lines 6-12. Changes the framebuffer binding, viewport, blend state and texture units.

@@ -17,6 +17,7 @@
 // Keys starting with "//" are comments and are ignored everywhere.
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -118,6 +119,18 @@ concept HasRequired = requires {
   T::kRequired;
 };
 
+// A field type with its own JSON form (e.g. "a preset name or a full object"): it reads and
+// writes itself and names its type for the docs. `DocObject` (a visitable struct) documents the
+// object form's keys.
+template <class T>
+concept CustomJson = requires(T & t, const T& ct, const Json& j, const std::string& p,
+                              const JsonSource& s) {
+  t.read_json_custom(j, p, s);
+  { ct.to_json_custom() } -> std::same_as<Json>;
+  { T::doc_type_custom() } -> std::convertible_to<std::string>;
+  typename T::DocObject;
+};
+
 template <NamedEnum E>
 std::vector<std::string> enum_name_list() {
   std::vector<std::string> out;
@@ -172,7 +185,9 @@ template <class T>
 void read_json(const Json& j, const std::string& path, T& out, const JsonSource& src,
                const ParamInfo& info) {
   using namespace detail;
-  if constexpr (std::is_same_v<T, bool>) {
+  if constexpr (CustomJson<T>) {
+    out.read_json_custom(j, path, src);
+  } else if constexpr (std::is_same_v<T, bool>) {
     if (!j.is_boolean()) json_fail(src, path, "expected true or false, got " + describe_json(j));
     out = j.get<bool>();
   } else if constexpr (std::is_integral_v<T>) {
@@ -278,8 +293,10 @@ struct FieldWriter {
 template <class T>
 Json to_json(const T& value) {
   using namespace detail;
-  if constexpr (std::is_same_v<T, bool> || std::is_arithmetic_v<T> ||
-                std::is_same_v<T, std::string>) {
+  if constexpr (CustomJson<T>) {
+    return value.to_json_custom();
+  } else if constexpr (std::is_same_v<T, bool> || std::is_arithmetic_v<T> ||
+                       std::is_same_v<T, std::string>) {
     return Json(value);
   } else if constexpr (NamedEnum<T>) {
     return Json(enum_to_string(value));
@@ -318,7 +335,9 @@ namespace detail {
 
 template <class T>
 std::string doc_type_name() {
-  if constexpr (std::is_same_v<T, bool>)
+  if constexpr (CustomJson<T>)
+    return T::doc_type_custom();
+  else if constexpr (std::is_same_v<T, bool>)
     return "boolean";
   else if constexpr (std::is_integral_v<T>)
     return "integer";
@@ -370,10 +389,23 @@ struct DocCollector {
                req ? std::string("required") : doc_default(to_json(field)),
                doc_range(info, numeric || vec_numeric),
                info.doc};
-    if constexpr (Visitable<T>) {
+    if constexpr (CustomJson<T>) {
+      rows.push_back(row);
+      typename T::DocObject elem{};
+      collect_doc_rows(key, elem, rows);
+    } else if constexpr (Visitable<T>) {
       row.default_value = "";
       rows.push_back(row);
       collect_doc_rows(key, field, rows);
+    } else if constexpr (is_optional<T>::value) {
+      if constexpr (Visitable<typename T::value_type>) {
+        row.default_value = "absent";
+        rows.push_back(row);
+        typename T::value_type elem{};
+        collect_doc_rows(key, elem, rows);
+      } else {
+        rows.push_back(row);
+      }
     } else if constexpr (vector_of_visitable<T>::value) {
       rows.push_back(row);
       typename T::value_type elem{};

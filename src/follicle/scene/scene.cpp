@@ -41,6 +41,55 @@ void Scene::validate(const JsonSource& src) const {
     if (lights[i].direction.norm() < 1e-12)
       json_fail(src, index_path("lights", i) + ".direction", "light direction is zero");
   }
+  for (std::size_t i = 0; i < hair.size(); ++i) {
+    const auto& h = hair[i];
+    const std::string p = index_path("hair", i);
+    if (h.mesh.empty()) json_fail(src, p + ".mesh", "mesh name is empty");
+    if (!names.count(h.mesh)) {
+      const std::vector<std::string> known(names.begin(), names.end());
+      const std::string hint = suggest(h.mesh, known);
+      json_fail(src, p + ".mesh",
+                "no mesh asset named \"" + h.mesh + "\"" +
+                    (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
+                    "; hair grows on a mesh of assets.meshes with that name");
+    }
+    try {
+      h.dynamics.validate();
+    } catch (const Error& e) {
+      json_fail(src, p + ".dynamics", e.what());
+    }
+    try {
+      h.shading.validate();
+    } catch (const Error& e) {
+      json_fail(src, p + ".shading", e.what());
+    }
+    try {
+      h.hull_fit.validate();
+    } catch (const Error& e) {
+      json_fail(src, p + ".hull_fit", e.what());
+    }
+  }
+  if (animation) {
+    const auto& a = *animation;
+    const auto& m = a.head_motion;
+    if (a.frames == 0 && a.duration <= 0.0)
+      json_fail(src, "animation.frames", "give the clip length: frames > 0 or duration > 0");
+    if ((m.kind == HeadMotionKind::Turn || m.kind == HeadMotionKind::Shake)) {
+      if (!(m.t1 > m.t0))
+        json_fail(src, "animation.head_motion.t1",
+                  fmt::format("t1 ({}) must be greater than t0 ({})", m.t1, m.t0));
+      if (m.axis.norm() < 1e-9) json_fail(src, "animation.head_motion.axis", "axis is zero");
+    }
+    if (m.interp != "step" && m.interp != "linear" && m.interp != "smooth")
+      json_fail(src, "animation.head_motion.interp",
+                "unknown value \"" + m.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
+    if (m.kind == HeadMotionKind::Keyframes && m.keys.empty())
+      json_fail(src, "animation.head_motion.keys", "kind \"keyframes\" needs at least one key");
+    for (std::size_t k = 1; k < m.keys.size(); ++k)
+      if (!(m.keys[k].t > m.keys[k - 1].t))
+        json_fail(src, index_path("animation.head_motion.keys", k) + ".t",
+                  "key times must increase strictly");
+  }
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const auto& o = outputs[i];
     const std::string p = index_path("outputs", i) + ".path";

@@ -17,6 +17,7 @@
 #include "follicle/core/params.hpp"
 #include "follicle/core/types.hpp"
 #include "follicle/core/units.hpp"
+#include "follicle/scene/hair_section.hpp"
 #include "follicle/scene/json_params.hpp"
 
 namespace follicle::scene {
@@ -183,6 +184,8 @@ struct Scene {
   std::vector<LightSpec> lights;
   RenderSpec render;
   std::vector<OutputSpec> outputs;
+  std::vector<HairGroupSpec> hair;
+  std::optional<AnimationSpec> animation;
 
   template <class V>
   void visit(V&& v) {
@@ -194,6 +197,9 @@ struct Scene {
     v("lights", lights, ParamInfo{"directional lights"});
     v("render", render, ParamInfo{"image settings"});
     v("outputs", outputs, ParamInfo{"files `follicle render` writes when no -o is given"});
+    v("hair", hair, ParamInfo{"hair groups grown on mesh assets (Anjyo 1992)"});
+    v("animation", animation,
+      ParamInfo{"frame rate, clip length, head motion and wind (absent: a still scene)"});
   }
 
   /// Cross-field checks the per-key ranges cannot express (near < far, eye != target, unique

@@ -2,9 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <set>
+
 #include "follicle/core/log.hpp"
 #include "follicle/geom/mesh_io.hpp"
+#include "follicle/hair/shading_anjyo1992.hpp"
 #include "follicle/image/image_io.hpp"
+#include "follicle/scene/hair_runtime.hpp"
 
 namespace follicle::scene {
 
@@ -127,12 +131,18 @@ render::RenderScene Session::render_scene(int frame) {
   }
   rs.ambient_color = m_scene.render.ambient_color;
   rs.background = m_scene.render.background;
+  // Meshes that grow hair follow the head motion.
+  const auto motion = head_motion_transform(frame);
+  std::set<std::string> hair_meshes;
+  for (const auto& h : m_scene.hair) hair_meshes.insert(h.mesh);
   for (std::size_t i = 0; i < m_scene.assets.meshes.size(); ++i) {
     const auto& a = m_scene.assets.meshes[i];
     if (!a.visible) continue;
     render::MeshItem item;
     item.mesh = mesh(i);
     item.transform = a.transform.matrix();
+    if (motion && !a.name.empty() && hair_meshes.count(a.name))
+      item.transform = *motion * item.transform;
     item.cast_shadow = a.cast_shadow;
     auto& mat = item.material;
     mat.shading = to_render(a.material.shading);
@@ -142,6 +152,23 @@ render::RenderScene Session::render_scene(int frame) {
     mat.ambient = a.material.ambient;
     if (!a.material.texture.empty()) mat.albedo_map = texture(a.material.texture);
     rs.meshes.push_back(std::move(item));
+  }
+  // Hair: Anjyo 1992 §4 shading per node (eqs. 8, 9; k_a per strand) on the CPU, drawn as
+  // vertex-coloured z-buffered polylines; the key light is the first light.
+  const Vec3 to_light = m_scene.lights.empty() ? (c.eye - c.target).normalized()
+                                               : Vec3(-m_scene.lights[0].direction.normalized());
+  for (std::size_t i = 0; i < m_scene.hair.size(); ++i) {
+    const auto& h = m_scene.hair[i];
+    auto shaded = std::make_shared<geom::StrandSet>(*hair_strands(i, frame));
+    hair::shade_anjyo1992(*m_ctx, *shaded, h.shading, c.eye, to_light, h.seed);
+    render::StrandItem item;
+    item.strands = std::move(shaded);
+    item.material.shading = render::StrandShading::VertexColor;
+    item.material.color = h.shading.hair_color;
+    item.material.width_px = h.render.width_px;
+    item.material.opacity = h.render.opacity;
+    item.cast_shadow = false;  // 1-px lines make a speckled shadow map; the paper has no shadows
+    rs.strands.push_back(std::move(item));
   }
   return rs;
 }
@@ -174,6 +201,14 @@ std::string Session::summary() const {
   out += fmt::format("lights: {}\n", m_scene.lights.size());
   out += fmt::format("render: {}x{} px, supersample {}\n", m_scene.render.width,
                      m_scene.render.height, m_scene.render.supersample);
+  for (const auto& h : m_scene.hair)
+    out += fmt::format("hair: {} on mesh \"{}\", style {}, density scale {}\n", h.name, h.mesh,
+                       h.style.custom ? "\"" + h.style.custom->name + "\" (custom)"
+                                      : "\"" + h.style.preset + "\"",
+                       h.density_scale);
+  if (m_scene.animation)
+    out += fmt::format("animation: {} frames at {} fps\n", m_scene.animation->frame_count(),
+                       m_scene.animation->fps);
   out += fmt::format("outputs: {}\n", m_scene.outputs.size());
   for (const auto& o : m_scene.outputs) out += fmt::format("  image {}\n", o.path);
   return out;

@@ -5,15 +5,27 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "follicle/core/context.hpp"
+#include "follicle/geom/strands.hpp"
 #include "follicle/geom/trimesh.hpp"
 #include "follicle/image/image.hpp"
 #include "follicle/render/render_scene.hpp"
 #include "follicle/scene/scene.hpp"
 
 namespace follicle::scene {
+
+class HairRuntime;  // session_hair.cpp
+
+/// Counters of the hair pipeline (tests check that cached frames are not re-simulated).
+struct HairStats {
+  std::size_t builds = 0;       // hair groups styled
+  std::size_t steps = 0;        // dynamics steps taken
+  std::size_t cache_reads = 0;  // frames read from the strand cache
+  std::size_t cache_writes = 0;
+};
 
 class Session {
  public:
@@ -26,6 +38,9 @@ class Session {
                            const std::string& name_for_errors, const Context& ctx);
   /// From an already built Scene (validated here).
   Session(Scene scene, std::filesystem::path base_dir, std::string source_name, const Context& ctx);
+  ~Session();
+  Session(Session&&) noexcept;
+  Session& operator=(Session&&) noexcept;
 
   const Scene& scene() const { return m_scene; }
   /// For command-line overrides (e.g. --width); call validate() after editing.
@@ -53,6 +68,23 @@ class Session {
   render::RenderScene render_scene(int frame = 0);
   render::RenderSettings render_settings() const;
 
+  /// Number of frames of the scene's animation (1 for a still scene) and the time of a frame.
+  int frame_count() const;
+  double frame_time(int frame) const;
+  /// Per-frame strand cache folder ("" = none): frames found there are read instead of simulated,
+  /// simulated frames are written there. A cache made for different hair/animation settings is
+  /// discarded (its key file differs).
+  void set_strand_cache(const std::filesystem::path& dir);
+  /// World-space strands of hair group `group` at `frame` (uncoloured): the styled hair for a
+  /// still scene, else the dynamics stepped deterministically from frame 0 (consecutive frames
+  /// continue from the kept state). Throws when the dynamics blow up.
+  std::shared_ptr<const geom::StrandSet> hair_strands(std::size_t group, int frame);
+  /// Every hair group at `frame`, concatenated (for export).
+  geom::StrandSet all_hair(int frame);
+  const HairStats& hair_stats() const;
+  /// The rigid head-motion transform at `frame` (rest -> current), none for a still head.
+  std::optional<Affine3> head_motion_transform(int frame);
+
   /// A few lines describing the scene (for `follicle info`).
   std::string summary() const;
 
@@ -63,6 +95,8 @@ class Session {
   const Context* m_ctx;
   std::map<std::string, std::shared_ptr<const geom::TriMesh>> m_meshes;
   std::map<std::string, std::shared_ptr<const image::ImageRGBA8>> m_textures;
+  std::unique_ptr<HairRuntime> m_hair;
+  HairRuntime& hair_runtime();
 };
 
 }  // namespace follicle::scene

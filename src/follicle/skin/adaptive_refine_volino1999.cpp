@@ -67,10 +67,26 @@ RefinedMesh refine_around_wrinkles(const geom::TriMesh& base,
     keys.reserve(split.size());
     for (const auto& kv : split) keys.push_back(kv.first);
     std::sort(keys.begin(), keys.end());
+    std::vector<Vec3> vn;  // area-weighted vertex normals of this level (for smooth midpoints)
+    if (params.smooth) {
+      vn.assign(m.positions.size(), Vec3::Zero());
+      for (const auto& F : m.faces) {
+        const Vec3 c = (m.positions[std::size_t(F[1])] - m.positions[std::size_t(F[0])])
+                           .cross(m.positions[std::size_t(F[2])] - m.positions[std::size_t(F[0])]);
+        for (int k = 0; k < 3; ++k) vn[std::size_t(F[k])] += c;
+      }
+      for (auto& n : vn) n = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero();
+    }
     for (uint64_t k : keys) {
       const int a = int(k >> 32), b = int(k & 0xffffffffu);
       split[k] = int(m.positions.size());
-      m.positions.push_back(0.5 * (m.positions[std::size_t(a)] + m.positions[std::size_t(b)]));
+      const Vec3 pa = m.positions[std::size_t(a)], pb = m.positions[std::size_t(b)];
+      Vec3 mid = 0.5 * (pa + pb);
+      if (params.smooth) {  // midpoint of the PN-triangle cubic edge (Vlachos et al. 2001)
+        const Vec3 &na = vn[std::size_t(a)], &nb = vn[std::size_t(b)];
+        mid -= ((pb - pa).dot(na) * na + (pa - pb).dot(nb) * nb) / 8.0;
+      }
+      m.positions.push_back(mid);
       out.parents.push_back({a, b});
     }
     std::map<std::pair<int, int>, int> uv_mid;  // UV edge -> new UV index

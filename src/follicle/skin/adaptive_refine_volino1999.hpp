@@ -4,7 +4,11 @@
 // their midpoints, for a few levels. Marking is per edge, so both triangles sharing an edge split
 // it at the same new vertex: the result has no T-junctions (crack-free). New vertices carry
 // texture coordinates (split per UV chart) and their two parents, so any per-vertex quantity
-// (weights, thickness, deformed positions) can be carried over by interpolation.
+// (weights, thickness) can be carried over by interpolation. With `smooth` (default) a new vertex
+// is placed at the midpoint of the cubic PN-triangle edge through the two end points and their
+// vertex normals, (a + b)/2 - ((b - a).n_a n_a + (a - b).n_b n_b)/8, so a refined region stays
+// as smooth as the surface it approximates instead of showing the flat facets of the input
+// mesh under smooth shading.
 #include <array>
 #include <vector>
 
@@ -18,8 +22,10 @@ struct RefineParams {
   int max_levels = 3;          // split passes
   double edge_factor = 0.5;    // target edge length = edge_factor * wrinkle width
   double region_widths = 6.0;  // refine within this many widths of the furrow
+  bool smooth = true;  // new vertices on the curved (PN-triangle) edge, not the flat midpoint
   template <class V>
   void visit(V&& v) {
+    v("smooth", smooth, ParamInfo{"place new vertices on the smooth surface through the normals", ""});
     v("max_levels", max_levels, ParamInfo{"refinement passes", "", 0, 8});
     v("edge_factor", edge_factor, ParamInfo{"target edge length / wrinkle width", "", 0.05, 10.0});
     v("region_widths", region_widths,

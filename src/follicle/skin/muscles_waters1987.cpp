@@ -13,6 +13,8 @@ void LinearMuscle::validate() const {
   const std::string where = "muscle '" + name + "'";
   validate_params(*this, where);
   if ((insertion - origin).norm() < 1e-9) fail_at(where, "origin and insertion coincide");
+  if (profile != "waters" && profile != "smooth")
+    fail_at(where, "profile '{}' is not one of: waters, smooth", profile);
   if (falloff_start >= falloff_end)
     fail_at(where, "falloff_start {} must be smaller than falloff_end {}", falloff_start,
             falloff_end);
@@ -115,6 +117,17 @@ double linear_muscle_factor(const LinearMuscle& m, const Vec3& p) {
   const double cos_zone = std::cos(m.zone);
   const double cosa = va.dot(vb) / (valen * vblen);
   if (cosa < cos_zone || vblen > m.falloff_end) return 0.0;
+  if (m.profile == "smooth") {
+    // C1 variant (see LinearMuscle): smoothstep in the angular coordinate, raised cosine radially.
+    const double t = std::clamp((cosa - cos_zone) / (1.0 - cos_zone), 0.0, 1.0);
+    const double angular = t * t * (3.0 - 2.0 * t);
+    double radial = 1.0;
+    if (vblen >= m.falloff_start) {
+      const double x = (vblen - m.falloff_start) / (m.falloff_end - m.falloff_start);
+      radial = 0.5 * (1.0 + std::cos(x * kPi));
+    }
+    return -angular * radial;
+  }
   const double angular = 1.0 - cosa / cos_zone;  // <= 0 inside the zone: pulls toward origin
   double radial = 1.0;                           // cosine radial fall-off
   if (vblen >= m.falloff_start) {
@@ -132,13 +145,16 @@ double sphincter_factor(const SphincterMuscle& m, const Vec3& p, Vec3* pull) {
   const Vec3 eb = (m.semi_axis_b - m.semi_axis_b.dot(ea) * ea).normalized();
   const Vec3 n = ea.cross(eb);
   const Vec3 d = p - m.center;
-  if (std::abs(d.dot(n)) > m.depth) return 0.0;
+  const double z = std::abs(d.dot(n));
+  if (z >= m.depth) return 0.0;
   const double x = d.dot(ea), y = d.dot(eb);
   const double rho = std::sqrt((x / a) * (x / a) + (y / b) * (y / b));
   if (rho >= 1.0) return 0.0;
   double f = 1.0;
-  if (rho > m.falloff_start)
-    f = std::cos((rho - m.falloff_start) / (1.0 - m.falloff_start) * 0.5 * kPi);
+  if (rho > m.falloff_start)  // raised cosine: 0 with zero slope at the outline
+    f = 0.5 * (1.0 + std::cos((rho - m.falloff_start) / (1.0 - m.falloff_start) * kPi));
+  const double zt = std::clamp((z - 0.5 * m.depth) / (0.5 * m.depth), 0.0, 1.0);
+  f *= 1.0 - zt * zt * (3.0 - 2.0 * zt);  // smooth fade across the depth limit
   *pull = -(x * ea + y * eb);  // toward the centre within the ellipse plane
   return f;
 }

@@ -18,6 +18,14 @@ namespace follicle::skin {
 ///   delta = k * (1 - cos/cos(zone)) * R(|v|) * v,  R = 1 below falloff_start, else
 ///   cos(((|v| - fs)/(fe - fs)) * 90 deg).
 /// Inside the zone (1 - cos/cos zone) <= 0, so k > 0 pulls the vertex toward the bony origin.
+/// That is Waters' profile ("waters"): it reaches 0 at the zone edge and at falloff_end, but with
+/// a non-zero slope, so the strain jumps there (a visible crease under strong contraction).
+/// Profile "smooth" keeps Waters' structure (zone cone, fs/fe, delta proportional to v) with C1
+/// fall-offs that reach 0 with zero slope:
+///   t = (cos - cos zone)/(1 - cos zone), A = t^2 (3 - 2t),
+///   R = 1 below fs, (1 + cos(pi (|v| - fs)/(fe - fs)))/2 up to fe,
+///   delta = -k A R v,
+/// so k is the compression strain on the muscle axis inside fs (k = 0.2: 20 % shortening).
 struct LinearMuscle {
   std::string name;
   Vec3 origin = Vec3::Zero();             // bony attachment; vertices move toward it [m]
@@ -25,9 +33,11 @@ struct LinearMuscle {
   double falloff_start = 0.001;           // fs [m]
   double falloff_end = 0.04;              // fe [m]
   double zone = 0.7853981633974483;       // angular zone half-angle [rad]
+  std::string profile = "waters";         // "waters" (Waters 1987/SimpleFace) or "smooth" (C1)
   template <class V>
   void visit(V&& v) {
     v("name", name, ParamInfo{"muscle name", ""});
+    v("profile", profile, ParamInfo{"fall-off profile: waters | smooth", ""});
     v("origin", origin, ParamInfo{"bony origin (vertices move toward it)", "m", -10.0, 10.0});
     v("insertion", insertion, ParamInfo{"skin insertion", "m", -10.0, 10.0});
     v("falloff_start", falloff_start, ParamInfo{"radial fall-off start", "m", 0.0, 10.0});
@@ -39,9 +49,11 @@ struct LinearMuscle {
 };
 
 /// Sphincter muscle (elliptical, Waters 1987): pulls vertices inside the ellipse toward its
-/// centre within the ellipse plane: delta = k * F(rho) * (c - p)_plane with
-/// rho = sqrt((x/a)^2 + (y/b)^2), F = 1 for rho <= falloff_start, cos(((rho - fs)/(1 - fs)) 90 deg)
-/// up to rho = 1, 0 outside.
+/// centre within the ellipse plane: delta = k * F(rho) * G(z) * (c - p)_plane with
+/// rho = sqrt((x/a)^2 + (y/b)^2), F = 1 for rho <= falloff_start, (1 + cos(pi (rho - fs)/(1 - fs)))/2
+/// up to rho = 1, 0 outside, and G = 1 - smoothstep((|z| - depth/2) / (depth/2)) across the
+/// ellipse plane (z = distance along its normal). F and G reach 0 with zero slope: no crease at
+/// the ellipse outline or at the depth limit.
 struct SphincterMuscle {
   std::string name;
   Vec3 center = Vec3::Zero();               // [m]

@@ -124,6 +124,7 @@ TEST(LcpPhysics, DISABLED_BackHairHangsUnderGravityPicture) {
   auto head = test::lcp_sphere(0.1);
   ScalpParams sp;
   sp.max_length = 0.2;
+  if (std::getenv("SR")) sp.root_depth = std::atof(std::getenv("SR"));
   // A cap over the back of the head (the +z side faces the viewer, the back is -z).
   hair::ScalpCurves curves;
   auto P = [](double polar, double az) -> Vec3 {
@@ -141,9 +142,27 @@ TEST(LcpPhysics, DISABLED_BackHairHangsUnderGravityPicture) {
   sim::VoxelPlanes body = sim::VoxelPlanes::build({&head}, {}, 3);
   LcpInitParams ip;
   ip.spacing = 0.012;
-  ip.whirl_point = P(0.3, kPi / 2);
+  ip.whirl_point = P(std::getenv("WP") ? std::atof(std::getenv("WP")) : 0.3, kPi / 2);
+  if (std::getenv("SAG")) ip.cantilever_sag = std::atof(std::getenv("SAG"));
+  if (std::getenv("WN")) ip.w_n = std::atof(std::getenv("WN"));
   auto init = initialize_lcp(ctx, scalp, ip, &body);
   LcpParams p;
+  if (std::getenv("EE")) p.elastic_modulus = std::atof(std::getenv("EE"));
+  if (std::getenv("HH")) p.hair_hair = std::atoi(std::getenv("HH"));
+  {
+    std::size_t nr = 0;
+    for (auto r : init.model.root) nr += r;
+    const auto& m = init.model;
+    for (std::size_t i = 0; i < m.size() && std::getenv("LCP_ORPH"); ++i) {
+      if (m.root[i]) continue;
+      int nr2 = 0, nt = 0;
+      for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e)
+        (m.pair_b[m.adj_pairs[e]] == i ? nr2 : nt)++;
+      if (nr2 == 0)
+        std::printf("orphan %zu s %.4f uv %.3f %.3f x %.3f %.3f %.3f t %.2f %.2f %.2f nt %d\n", i, m.uvs[i].z(), m.uvs[i].x(), m.uvs[i].y(), m.rest_x[i].x(), m.rest_x[i].y(), m.rest_x[i].z(), m.rest_t[i].x(), m.rest_t[i].y(), m.rest_t[i].z(), nt);
+    }
+    std::printf("roots %zu of %zu, spacing %.4f h_s %.4f h %.4f\n", nr, init.model.size(), init.model.spacing, init.model.h_s, init.model.h);
+  }
   LcpSolver solver(p, init.model, &body);
   LcpState s = solver.rest_state();
   LcpWorkspace ws;
@@ -153,6 +172,27 @@ TEST(LcpPhysics, DISABLED_BackHairHangsUnderGravityPicture) {
     in.dt = 1.5 / steps;
     const auto rep = solver.step(ctx, in, s, ws);
     ASSERT_TRUE(rep.ok) << rep.message;
+    if (std::getenv("LCP_DIAG")) {
+      const auto& m = init.model;
+      std::size_t orphan = 0, broken = 0;
+      double smax = 0, miny = 1e9, smean = 0;
+      std::size_t na = 0;
+      for (std::size_t i = 0; i < m.size(); ++i) {
+        if (m.root[i]) continue;
+        miny = std::min(miny, s.x[i].y());
+        bool has = false;
+        for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+          const uint32_t q = m.adj_pairs[e];
+          if (m.pair_b[q] == i && ws.k[q] > 0) has = true;
+        }
+        if (!has) ++orphan;
+      }
+      for (std::size_t q = 0; q < m.num_pairs(); ++q) {
+        const double r = (s.x[m.pair_b[q]] - s.x[m.pair_a[q]]).norm() / m.l0[q];
+        if (ws.k[q] <= 0) ++broken; else { smax = std::max(smax, r); smean += r; ++na; }
+      }
+      std::printf("step %d sub %d vmax %.3f orphans %zu broken %zu strain max %.3f mean %.3f miny %.3f\n", k, rep.substeps, rep.max_speed, orphan, broken, smax, smean / na, miny);
+    }
   }
   double tip_y = 0, root_y = 0;
   int nt = 0, nr = 0;

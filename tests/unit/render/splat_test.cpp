@@ -40,15 +40,16 @@ double mean_lum(const image::ImageRGBA8& img, int x0, int y0, int x1, int y1) {
   return s / double((x1 - x0) * (y1 - y0));
 }
 
-/// A cube of particles of side `side` centred at `c` (n^3 of them), directions along y.
-std::shared_ptr<geom::ParticleSet> particle_block(const Vec3& c, double side, int n) {
+/// A cube of particles of side `side` centred at `c` (n^3 of them), directions `t`.
+std::shared_ptr<geom::ParticleSet> particle_block(const Vec3& c, double side, int n,
+                                                  const Vec3f& t = Vec3f(0, 1, 0)) {
   auto ps = std::make_shared<geom::ParticleSet>();
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const Vec3 p = c + side * (Vec3(i, j, k) / (n - 1) - Vec3::Constant(0.5));
         ps->positions.push_back(p.cast<float>());
-        ps->directions.emplace_back(0.0f, 1.0f, 0.0f);
+        ps->directions.push_back(t);
       }
   return ps;
 }
@@ -271,7 +272,9 @@ TEST_F(Splat, HairShadowsTheHeadUnderIt) {
   m.material.specular = 0;
   m.material.ambient = 0;
   s.meshes.push_back(m);
-  s.particles.push_back(hair_item(particle_block(Vec3(-0.5, 1.4, 0.45), 0.5, 6), 0.06, 0.6));
+  // Hair along x: Kajiya-Kay's sin(t, l) = 1 for the light from above.
+  s.particles.push_back(
+      hair_item(particle_block(Vec3(-0.5, 1.4, 0.45), 0.5, 8, Vec3f(1, 0, 0)), 0.08, 0.6));
   const int w = 128, h = 128;
   RenderSettings rs = settings(w, h);
   const auto with = renderer().render(s, rs);
@@ -282,17 +285,17 @@ TEST_F(Splat, HairShadowsTheHeadUnderIt) {
   const Vec3 under(-0.5, std::sqrt(1 - 0.25 - 0.45 * 0.45), 0.45), free(0.5, under.y(), 0.45);
   const Vec2 pu = *project_to_pixel(s.camera, w, h, under);
   const Vec2 pf = *project_to_pixel(s.camera, w, h, free);
-  const double u_with = mean_lum(with, int(pu.x()) - 2, int(pu.y()) - 2, int(pu.x()) + 3,
-                                 int(pu.y()) + 3);
-  const double u_without = mean_lum(without, int(pu.x()) - 2, int(pu.y()) - 2,
-                                    int(pu.x()) + 3, int(pu.y()) + 3);
-  const double f_with = mean_lum(with, int(pf.x()) - 2, int(pf.y()) - 2, int(pf.x()) + 3,
-                                 int(pf.y()) + 3);
-  const double f_without = mean_lum(without, int(pf.x()) - 2, int(pf.y()) - 2,
-                                    int(pf.x()) + 3, int(pf.y()) + 3);
+  const double u_with =
+      mean_lum(with, int(pu.x()) - 2, int(pu.y()) - 2, int(pu.x()) + 3, int(pu.y()) + 3);
+  const double u_without =
+      mean_lum(without, int(pu.x()) - 2, int(pu.y()) - 2, int(pu.x()) + 3, int(pu.y()) + 3);
+  const double f_with =
+      mean_lum(with, int(pf.x()) - 2, int(pf.y()) - 2, int(pf.x()) + 3, int(pf.y()) + 3);
+  const double f_without =
+      mean_lum(without, int(pf.x()) - 2, int(pf.y()) - 2, int(pf.x()) + 3, int(pf.y()) + 3);
   EXPECT_GT(u_without, 100.0);
   EXPECT_LT(u_with, 0.6 * u_without) << u_with << " " << u_without;
-  EXPECT_NEAR(f_with, f_without, 2.0);  // not under the hair: unchanged
+  EXPECT_NEAR(f_with, f_without, 2.0);     // not under the hair: unchanged
   EXPECT_NEAR(u_without, f_without, 3.0);  // symmetric without the hair shadow
 }
 
@@ -310,8 +313,8 @@ TEST_F(Splat, ParticlesInTheHeadShadowAreDark) {
   MeshItem m;
   m.mesh = make_sphere(1.0);
   s.meshes.push_back(m);
-  auto a = particle_block(Vec3(0, -1.8, 0), 0.4, 4);
-  auto b = particle_block(Vec3(1.6, -1.8, 0), 0.4, 4);
+  auto a = particle_block(Vec3(0, -1.8, 0), 0.4, 4, Vec3f(1, 0, 0));
+  auto b = particle_block(Vec3(1.6, -1.8, 0), 0.4, 4, Vec3f(1, 0, 0));
   a->positions.insert(a->positions.end(), b->positions.begin(), b->positions.end());
   a->directions.insert(a->directions.end(), b->directions.begin(), b->directions.end());
   ParticleItem it = hair_item(a, 0.05, 0.5);
@@ -322,10 +325,10 @@ TEST_F(Splat, ParticlesInTheHeadShadowAreDark) {
   maybe_save(img, "splat_in_head_shadow.png");
   const Vec2 pa = *project_to_pixel(s.camera, w, h, Vec3(0, -1.8, 0.2));
   const Vec2 pb = *project_to_pixel(s.camera, w, h, Vec3(1.6, -1.8, 0.2));
-  const double la = mean_lum(img, int(pa.x()) - 6, int(pa.y()) - 6, int(pa.x()) + 6,
-                             int(pa.y()) + 6);
-  const double lb = mean_lum(img, int(pb.x()) - 6, int(pb.y()) - 6, int(pb.x()) + 6,
-                             int(pb.y()) + 6);
+  const double la =
+      mean_lum(img, int(pa.x()) - 6, int(pa.y()) - 6, int(pa.x()) + 6, int(pa.y()) + 6);
+  const double lb =
+      mean_lum(img, int(pb.x()) - 6, int(pb.y()) - 6, int(pb.x()) + 6, int(pb.y()) + 6);
   EXPECT_GT(lb, 40.0);
   EXPECT_LT(la, 0.1 * lb) << la << " " << lb;
 }
@@ -360,8 +363,8 @@ TEST_F(Splat, OpacityGrowsAsTheViewAlignsWithTheHair) {
   const double a30 = alpha_at(Vec3(0, std::sin(th), std::cos(th)), 0.2, &e30);
   const double a0 = alpha_at(Vec3(0, 0, 1), 0.2);
   EXPECT_NEAR(a90, 0.2, 0.01);
-  EXPECT_NEAR(a30, 0.4, 0.015);  // 1 / sin(30 deg) = 2
-  EXPECT_NEAR(a0, 0.8, 0.02);    // sin clamped at 0.25
+  EXPECT_NEAR(a30, 0.4, 0.015);                           // 1 / sin(30 deg) = 2
+  EXPECT_NEAR(a0, 0.8, 0.02);                             // sin clamped at 0.25
   EXPECT_NEAR(alpha_at(Vec3(0, 0, 1), 0.5), 1.0, 0.005);  // opacity clamped at 1
   // ... while the billboard's projected length shrinks by sin(theta).
   EXPECT_NEAR(double(e30) / e90, 0.5, 0.1);

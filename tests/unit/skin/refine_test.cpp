@@ -14,6 +14,7 @@ TEST(Refine, CrackFreeWithUvsAndParents) {
   w.width = 0.002;
   RefineParams rp;
   rp.max_levels = 3;
+  rp.smooth = false;  // flat midpoints: exact parent averages (checked below)
   const RefinedMesh r = refine_around_wrinkles(base, {w}, rp);
   EXPECT_GT(r.mesh.faces.size(), base.faces.size());
   EXPECT_EQ(r.mesh.positions.size(), std::size_t(r.base_vertices) + r.parents.size());
@@ -43,4 +44,31 @@ TEST(Refine, DetectsTJunction) {
   m.faces = {Vec3i(0, 1, 2), Vec3i(0, 4, 3),
              Vec3i(3, 4, 1)};  // vertex 3 splits edge 0-1 on one side only
   EXPECT_GT(count_t_junctions(m), 0);
+}
+
+TEST(Refine, SmoothMidpointsLieOnTheCurvedSurface) {
+  // On a cylinder of radius R the flat midpoint of a chord sags inside by ~ L^2/(8R); the
+  // PN-triangle midpoint must be much closer to the surface, with the same topology.
+  const double R = 0.08;
+  const geom::TriMesh base = make_cylinder_patch(0.05, 0.04, R, 0.004);
+  LargeWrinkle w;
+  w.control = {Vec2(0.2, 0.5), Vec2(0.4, 0.5), Vec2(0.6, 0.5), Vec2(0.8, 0.5)};
+  w.width = 0.002;
+  RefineParams flat, smooth;
+  flat.smooth = false;
+  const RefinedMesh a = refine_around_wrinkles(base, {w}, flat);
+  const RefinedMesh b = refine_around_wrinkles(base, {w}, smooth);
+  ASSERT_EQ(a.mesh.faces, b.mesh.faces);
+  auto worst = [&](const RefinedMesh& r) {
+    double e = 0;
+    for (std::size_t v = std::size_t(r.base_vertices); v < r.mesh.positions.size(); ++v) {
+      const Vec3& p = r.mesh.positions[v];
+      e = std::max(e, std::abs(std::hypot(p.x(), p.z()) - R));  // cylinder axis = y
+    }
+    return e;
+  };
+  const double ea = worst(a), eb = worst(b);
+  EXPECT_GT(ea, 1e-6);
+  EXPECT_LT(eb, 0.25 * ea);
+  EXPECT_EQ(count_t_junctions(b.mesh, 1e-3), 0);
 }

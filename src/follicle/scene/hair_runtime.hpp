@@ -1,0 +1,37 @@
+#pragma once
+// Internal to the scene module: the hair state a Session keeps (styled strands, solver state,
+// strand cache, head-motion track). Included by session.cpp and session_hair.cpp only.
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "follicle/anim/rigid_motion.hpp"
+#include "follicle/geom/strands.hpp"
+#include "follicle/hair/projective_anjyo1992.hpp"
+#include "follicle/scene/session.hpp"
+#include "follicle/sim/ellipsoid.hpp"
+
+namespace follicle::scene {
+
+class HairRuntime {
+ public:
+  struct Group {
+    bool built = false;
+    sim::Ellipsoid hull;  // scene coordinates, at rest
+    std::shared_ptr<const geom::StrandSet> styled;
+    std::unique_ptr<hair::ProjectiveSolver> solver;
+    hair::ProjectiveState state;
+    int state_frame = -1;  // frame `state` belongs to (-1: none yet)
+    int last_frame = -1;   // frame of `last`
+    std::shared_ptr<const geom::StrandSet> last;
+  };
+  std::vector<Group> groups;
+  HairStats stats;
+  std::filesystem::path cache_dir;
+  bool cache_ready = false;
+  bool track_built = false;
+  std::optional<anim::RigidMotionTrack> track;
+};
+
+}  // namespace follicle::scene

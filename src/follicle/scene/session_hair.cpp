@@ -1,0 +1,276 @@
+// Session: hair groups (Anjyo, Usami, Kurihara 1992) and the animation clock. Hair is styled
+// once per group on the mesh at rest (the mesh asset's transform applied), in scene coordinates;
+// the dynamics run in the head frame (hull centre and axes) and follow the rigid head motion.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <set>
+
+#include "follicle/core/atomic_file.hpp"
+#include "follicle/core/log.hpp"
+#include "follicle/geom/spatial_embree.hpp"
+#include "follicle/hair/scalp.hpp"
+#include "follicle/hair/strand_cache.hpp"
+#include "follicle/scene/hair_runtime.hpp"
+#include "follicle/scene/session.hpp"
+
+namespace follicle::scene {
+
+
+namespace {
+
+std::filesystem::path group_cache_dir(const std::filesystem::path& dir, std::size_t g) {
+  return dir / fmt::format("hair{}", g);
+}
+
+}  // namespace
+
+Session::~Session() = default;
+Session::Session(Session&&) noexcept = default;
+Session& Session::operator=(Session&&) noexcept = default;
+
+HairRuntime& Session::hair_runtime() {
+  if (!m_hair) m_hair = std::make_unique<HairRuntime>();
+  if (m_hair->groups.size() != m_scene.hair.size()) m_hair->groups.resize(m_scene.hair.size());
+  return *m_hair;
+}
+
+const HairStats& Session::hair_stats() const {
+  static const HairStats kNone{};  // read-only empty counters (no mutable state)
+  return m_hair ? m_hair->stats : kNone;
+}
+
+int Session::frame_count() const {
+  return m_scene.animation ? m_scene.animation->frame_count() : 1;
+}
+
+double Session::frame_time(int frame) const {
+  return m_scene.animation ? double(frame) / m_scene.animation->fps : 0.0;
+}
+
+void Session::set_strand_cache(const std::filesystem::path& dir) {
+  auto& rt = hair_runtime();
+  rt.cache_dir = dir;
+  rt.cache_ready = false;
+}
+
+namespace {
+
+// Everything the cached strands depend on; a cache made with other settings is discarded.
+std::string cache_key(const Scene& s) {
+  Json k = Json::object();
+  k["cache_format"] = 1;
+  k["hair"] = to_json(s.hair);
+  k["animation"] = to_json(s.animation);
+  k["meshes"] = to_json(s.assets.meshes);
+  return k.dump(1) + "\n";
+}
+
+// The rigid motion of the head: x(t) = R(t) (x - pivot) + pivot + p(t).
+anim::RigidMotionTrack make_track(const HeadMotionSpec& m, const Vec3& pivot) {
+  const double k = kPi / 180.0;
+  switch (m.kind) {
+    case HeadMotionKind::Turn:
+      return anim::RigidMotionTrack::turn(pivot, m.axis.normalized(), m.angle_deg * k, m.t0, m.t1);
+    case HeadMotionKind::Shake:
+      return anim::RigidMotionTrack::shake(pivot, m.axis.normalized(), m.angle_deg * k, m.cycles,
+                                           m.t0, m.t1);
+    case HeadMotionKind::Keyframes: {
+      std::vector<anim::Key<Vec3>> pos, rot;
+      for (const auto& key : m.keys) {
+        pos.push_back({key.t, key.translate});
+        rot.push_back({key.t, key.rotate_deg * k});
+      }
+      const auto interp = anim::parse_interp(m.interp);
+      return anim::RigidMotionTrack(anim::VectorTrack(pos, interp, "animation.head_motion.keys"),
+                                    anim::VectorTrack(rot, interp, "animation.head_motion.keys"),
+                                    pivot);
+    }
+    case HeadMotionKind::None: break;
+  }
+  return {};
+}
+
+}  // namespace
+
+std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int frame) {
+  if (gi >= m_scene.hair.size())
+    fail("hair group {} out of range ({} groups)", gi, m_scene.hair.size());
+  if (frame < 0) fail("frame {} is negative", frame);
+  auto& rt = hair_runtime();
+  auto& g = rt.groups[gi];
+  const HairGroupSpec& h = m_scene.hair[gi];
+  const std::string where = fmt::format("{}: hair[{}] (\"{}\")", m_source, gi, h.name);
+
+  auto build = [&](std::size_t idx) {
+    auto& gg = rt.groups[idx];
+    if (gg.built) return;
+    const HairGroupSpec& hs = m_scene.hair[idx];
+    const std::string w = fmt::format("{}: hair[{}] (\"{}\")", m_source, idx, hs.name);
+    const std::size_t mi = mesh_index(hs.mesh);
+    geom::TriMesh world = *mesh(mi);
+    world.transform(m_scene.assets.meshes[mi].transform.matrix());
+    try {
+      gg.hull = hs.hull ? hs.hull->ellipsoid() : sim::fit_head_ellipsoid(world.positions, hs.hull_fit);
+      const geom::MeshQuery query(world);
+      const auto scalp = hair::mesh_query_closest_point(query);
+      const hair::HairStyle style = hs.style.resolve(hs.density_scale);
+      auto styled = hair::build_style(*m_ctx, gg.hull, style, hs.seed, scalp);
+      gg.styled = std::make_shared<const geom::StrandSet>(std::move(styled.strands));
+    } catch (const Error& e) {
+      fail("{}: {}", w, e.what());
+    }
+    gg.built = true;
+    ++rt.stats.builds;
+    m_ctx->log().info("{}: {} strands, {} points", w, gg.styled->num_strands(),
+                      gg.styled->num_points());
+  };
+  build(gi);
+  if (!m_scene.animation) return g.styled;
+  if (g.last && g.last_frame == frame) return g.last;
+
+  const AnimationSpec& anim_spec = *m_scene.animation;
+  if (!rt.track_built) {
+    if (anim_spec.head_motion.kind != HeadMotionKind::None) {
+      Vec3 pivot;
+      if (anim_spec.head_motion.pivot) {
+        pivot = *anim_spec.head_motion.pivot;
+      } else {  // the bottom of the first group's hull: roughly where the neck turns the head
+        build(0);
+        const auto& h0 = rt.groups[0].hull;
+        pivot = h0.centre - h0.rotation * Vec3(0.0, h0.radii.y(), 0.0);
+      }
+      rt.track = make_track(anim_spec.head_motion, pivot);
+    }
+    rt.track_built = true;
+  }
+
+  // Strand cache: check (or start) it once; frames found there are not simulated.
+  const bool use_cache = !rt.cache_dir.empty();
+  if (use_cache && !rt.cache_ready) {
+    const std::string key = cache_key(m_scene);
+    const auto key_file = rt.cache_dir / "cache_key.json";
+    std::error_code ec;
+    std::filesystem::create_directories(rt.cache_dir, ec);
+    if (ec) fail_at(rt.cache_dir.string(), "cannot create the strand cache folder: {}", ec.message());
+    const bool same = std::filesystem::is_regular_file(key_file) && read_file(key_file) == key;
+    if (!same) {  // stale frames from other settings: remove our own files only
+      for (std::size_t i = 0; i < m_scene.hair.size(); ++i) {
+        const auto d = group_cache_dir(rt.cache_dir, i);
+        if (!std::filesystem::is_directory(d)) continue;
+        for (const auto& e : std::filesystem::directory_iterator(d)) {
+          const auto name = e.path().filename().string();
+          if (name.rfind("strands_", 0) == 0 && e.path().extension() == ".fsc")
+            std::filesystem::remove(e.path(), ec);
+        }
+      }
+      write_file_atomically(key_file, key);
+    }
+    rt.cache_ready = true;
+  }
+  const auto gdir = group_cache_dir(rt.cache_dir, gi);
+  if (use_cache && hair::has_strand_frame(gdir, frame)) {
+    auto f = hair::read_strand_frame(gdir, frame);
+    ++rt.stats.cache_reads;
+    g.last = std::make_shared<const geom::StrandSet>(std::move(f.strands));
+    g.last_frame = frame;
+    return g.last;
+  }
+
+  // Head frame: origin at the hull centre, axes of the hull (y up, z to the face).
+  const Vec3 c = g.hull.centre;
+  const Mat3 Rh = g.hull.rotation;
+  if (!g.solver) {
+    geom::StrandSet rest = *g.styled;
+    for (auto& p : rest.points) p = (Rh.transpose() * (p.cast<double>() - c)).cast<float>();
+    sim::Ellipsoid hull_head = g.hull;
+    hull_head.centre = Vec3::Zero();
+    hull_head.rotation = Mat3::Identity();
+    try {
+      g.solver = std::make_unique<hair::ProjectiveSolver>(h.dynamics, hull_head, rest, h.seed);
+    } catch (const Error& e) {
+      fail("{}: dynamics: {}", where, e.what());
+    }
+  }
+  auto head_at = [&](double t) {
+    hair::HeadMotion hm;
+    hm.position = c;
+    hm.rotation = Quat(Rh);
+    if (!rt.track) return hm;
+    const anim::RigidSample s = rt.track->sample(t);
+    hm.position = s.apply(c);
+    hm.rotation = Quat(s.rotation * Rh);
+    hm.velocity = s.point_velocity(hm.position);
+    hm.acceleration = s.point_acceleration(hm.position);
+    hm.angular_velocity = s.angular_velocity;
+    hm.angular_acceleration = s.angular_acceleration;
+    return hm;
+  };
+  const double dt = h.dynamics.dt;
+  auto steps_for = [&](int f) { return uint64_t(std::llround(frame_time(f) / dt)); };
+  auto positions_at = [&](int f) {
+    auto out = std::make_shared<geom::StrandSet>();
+    g.solver->positions(g.state, head_at(double(g.state.step) * dt), *out);
+    if (use_cache) {
+      hair::StrandFrame sf;
+      sf.frame = f;
+      sf.time = frame_time(f);
+      sf.strands = *out;
+      hair::write_strand_frame(gdir, sf);
+      ++rt.stats.cache_writes;
+    }
+    return std::shared_ptr<const geom::StrandSet>(std::move(out));
+  };
+
+  std::shared_ptr<const geom::StrandSet> result;
+  if (g.state_frame < 0 || g.state_frame > frame) {  // (re)start deterministically at frame 0
+    g.state = g.solver->initial_state();
+    g.state_frame = 0;
+    if (frame == 0 || use_cache) result = positions_at(0);
+  }
+  while (g.state_frame < frame) {
+    const int f = g.state_frame + 1;
+    const uint64_t target = steps_for(f);
+    while (g.state.step < target) {
+      const double t = double(g.state.step) * dt;
+      hair::ProjectiveInput in;
+      in.gravity = anim_spec.gravity;
+      in.wind = anim_spec.wind.at(t);
+      in.head = head_at(t);
+      const sim::StepReport rep = g.solver->step(*m_ctx, in, g.state);
+      ++rt.stats.steps;
+      if (!rep.ok)
+        fail("{}: dynamics failed at frame {} (t = {:.4f} s): {}; try a smaller dynamics.dt", where,
+             f, t, rep.message);
+    }
+    g.state_frame = f;
+    if (f == frame || use_cache) result = positions_at(f);
+  }
+  if (!result) result = positions_at(frame);  // state already at `frame` (after a cache read)
+  g.last = result;
+  g.last_frame = frame;
+  return result;
+}
+
+std::optional<Affine3> Session::head_motion_transform(int frame) {
+  if (!m_scene.animation || m_scene.animation->head_motion.kind == HeadMotionKind::None ||
+      m_scene.hair.empty())
+    return std::nullopt;
+  auto& rt = hair_runtime();
+  if (!rt.track_built) hair_strands(0, 0);  // builds the hull the default pivot needs
+  if (!rt.track) return std::nullopt;
+  return rt.track->sample(frame_time(frame)).transform();
+}
+
+geom::StrandSet Session::all_hair(int frame) {
+  geom::StrandSet out;
+  for (std::size_t i = 0; i < m_scene.hair.size(); ++i) {
+    const auto s = hair_strands(i, frame);
+    const uint32_t base = uint32_t(out.points.size());
+    out.points.insert(out.points.end(), s->points.begin(), s->points.end());
+    for (std::size_t k = 1; k < s->offsets.size(); ++k) out.offsets.push_back(base + s->offsets[k]);
+  }
+  return out;
+}
+
+}  // namespace follicle::scene
