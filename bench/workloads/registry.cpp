@@ -13,6 +13,7 @@ void add_render_workloads(std::vector<Workload>& out);
 void add_fine_workloads(std::vector<Workload>& out);
 void add_anjyo_workloads(std::vector<Workload>& out);
 void add_skin_workloads(std::vector<Workload>& out);
+void add_splat_workloads(std::vector<Workload>& out);
 
 std::vector<Workload> all_workloads() {
   std::vector<Workload> out;
@@ -21,6 +22,7 @@ std::vector<Workload> all_workloads() {
   add_fine_workloads(out);
   add_anjyo_workloads(out);
   add_skin_workloads(out);
+  add_splat_workloads(out);
   return out;
 }
 

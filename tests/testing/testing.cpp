@@ -20,6 +20,11 @@ std::filesystem::path shared_data_dir() {
   return std::filesystem::exists(d) ? d : std::filesystem::path();
 }
 
+bool gl_required() {
+  const char* s = std::getenv("FOLLICLE_REQUIRE_GL");
+  return s != nullptr && *s != '\0' && std::string(s) != "0";
+}
+
 std::filesystem::path scratch_dir(const std::string& name) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string test = info ? std::string(info->test_suite_name()) + "." + info->name() : "x";

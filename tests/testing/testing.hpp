@@ -9,6 +9,9 @@ namespace follicle::test {
 std::filesystem::path source_dir();
 /// ../shared/data next to the repository, or $FOLLICLE_SHARED_DATA; empty path when absent.
 std::filesystem::path shared_data_dir();
+/// True when $FOLLICLE_REQUIRE_GL is set (tools/test.sh sets it): GL tests must then fail
+/// instead of skipping when no OpenGL context can be made.
+bool gl_required();
 /// A fresh, empty directory under the system temp dir, unique to this test.
 std::filesystem::path scratch_dir(const std::string& name);
 

@@ -92,6 +92,7 @@ LcpModel connect_particles(const Context& ctx, const std::vector<Vec3>& x,
   m.h = p.h_factor * m.spacing;
 
   // Candidate pairs within 2 h_s.
+  ParticleGrid grid;
   grid.build(x, 2 * m.h_s);
   std::vector<uint32_t> off, nb;
   grid.neighbour_lists(ctx, x, 2 * m.h_s, off, nb);

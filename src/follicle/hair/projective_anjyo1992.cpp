@@ -11,6 +11,7 @@
 #include "follicle/core/params.hpp"
 #include "follicle/core/rng.hpp"
 
+long g_pole = 0, g_clamp = 0;
 namespace follicle::hair {
 
 void ProjectiveParams::validate() const {
@@ -324,6 +325,7 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
       // double precision, before the general update overwrites θ^{n-1}.)
       for (std::size_t j = 0; j < n; ++j) {
         if (!S.flag[j]) continue;
+        __atomic_fetch_add(&g_pole, 1, __ATOMIC_RELAXED);
         double t = th[j], p = ph[j];
         const Vec3 dir = segment_direction(t, p);
         const Vec3 dirp = segment_direction(thn[j], phn[j]);  // still θ^{n-1}, φ^{n-1}
@@ -381,6 +383,7 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
           Vec3 nd = segment_direction(thn[j], phn[j]);
           const double c = pd.dot(nd);
           if (!(c < cs)) continue;
+          __atomic_fetch_add(&g_clamp, 1, __ATOMIC_RELAXED);
           Vec3 perp = nd - c * pd;
           const double pn = perp.norm();
           perp = pn > 1e-12 ? Vec3(perp / pn) : Vec3(pd.unitOrthogonal());

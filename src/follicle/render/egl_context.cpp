@@ -1,4 +1,5 @@
 #include "follicle/render/egl_context.hpp"
+#include "follicle/render/renderer.hpp"
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -66,7 +67,8 @@ std::unique_ptr<EglContext> EglContext::create() {
   auto query_device_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(
       eglGetProcAddress("eglQueryDeviceStringEXT"));
   if (!get_display)
-    fail("EGL: eglGetPlatformDisplayEXT is not available (no EGL_EXT_platform_base)");
+    throw ContextUnavailable(
+        "EGL: eglGetPlatformDisplayEXT is not available (no EGL_EXT_platform_base)");
 
   std::unique_ptr<EglContext> out(new EglContext());
   std::string why;
@@ -114,7 +116,8 @@ std::unique_ptr<EglContext> EglContext::create() {
       return out;
     }
   }
-  fail("cannot create a headless OpenGL 3.3 core context with EGL:{}", why);
+  throw ContextUnavailable(
+      fmt::format("cannot create a headless OpenGL 3.3 core context with EGL:{}", why));
 }
 
 EglContext::~EglContext() {

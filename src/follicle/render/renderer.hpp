@@ -6,10 +6,19 @@
 #include <string>
 
 #include "follicle/core/context.hpp"
+#include "follicle/core/error.hpp"
 #include "follicle/image/image.hpp"
 #include "follicle/render/render_scene.hpp"
 
 namespace follicle::render {
+
+/// Thrown when no headless OpenGL 3.3 core context can be made at all (no EGL, no Mesa). Tests
+/// skip on this error only (or fail when $FOLLICLE_REQUIRE_GL is set, as tools/test.sh does);
+/// every other renderer error is a real failure.
+class ContextUnavailable : public Error {
+ public:
+  using Error::Error;
+};
 
 class Renderer {
  public:

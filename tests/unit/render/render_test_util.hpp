@@ -9,6 +9,7 @@
 #include "follicle/core/context.hpp"
 #include "follicle/geom/trimesh.hpp"
 #include "follicle/render/renderer.hpp"
+#include "testing/testing.hpp"
 
 namespace follicle::render::testutil {
 
@@ -74,18 +75,25 @@ class RenderTest : public ::testing::Test {
     s_ctx = std::make_unique<Context>(2, 1);
     try {
       s_renderer = Renderer::create_headless(*s_ctx);
+    } catch (const ContextUnavailable& e) {
+      s_reason = e.what();  // no GL on this machine: skip (unless GL is required)
     } catch (const Error& e) {
-      s_reason = e.what();
+      s_reason = e.what();  // any other error (a shader that fails to compile...) is a failure
+      s_broken = true;
     }
   }
   void SetUp() override {
-    if (!s_renderer) GTEST_SKIP() << "no headless OpenGL context: " << s_reason;
+    if (s_renderer) return;
+    if (s_broken || ::follicle::test::gl_required())
+      FAIL() << "renderer could not be created: " << s_reason;
+    GTEST_SKIP() << "no headless OpenGL context: " << s_reason;
   }
   Renderer& renderer() { return *s_renderer; }
   static inline bool s_tried = false;
   static inline std::unique_ptr<Context> s_ctx;
   static inline std::unique_ptr<Renderer> s_renderer;
   static inline std::string s_reason;
+  static inline bool s_broken = false;
 };
 
 }  // namespace follicle::render::testutil
