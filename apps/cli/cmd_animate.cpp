@@ -26,7 +26,8 @@ namespace {
 // "A-B" or "A" -> [first, last]; -1 for an absent bound.
 void parse_frames(const std::string& s, int& first, int& last) {
   const auto bad = [&] {
-    return UsageError(fmt::format("--frames expects A-B (e.g. 0-47) or one frame number, got '{}'", s));
+    return UsageError(
+        fmt::format("--frames expects A-B (e.g. 0-47) or one frame number, got '{}'", s));
   };
   if (s.empty()) return;
   const auto dash = s.find('-');
@@ -42,7 +43,8 @@ void parse_frames(const std::string& s, int& first, int& last) {
     first = num(s.substr(0, dash));
     last = num(s.substr(dash + 1));
   }
-  if (last < first) throw UsageError(fmt::format("--frames {}: the last frame is before the first", s));
+  if (last < first)
+    throw UsageError(fmt::format("--frames {}: the last frame is before the first", s));
 }
 
 // The ffmpeg executable on PATH, or "".
@@ -99,13 +101,15 @@ int run_animate(const GlobalOptions& g, const AnimateArgs& a) {
     last = count - 1;
   }
   if (last >= count)
-    throw UsageError(fmt::format("--frames {}-{}: the scene has frames 0-{}", first, last, count - 1));
+    throw UsageError(
+        fmt::format("--frames {}-{}: the scene has frames 0-{}", first, last, count - 1));
   std::string ffmpeg;
   if (!a.no_video) {
     ffmpeg = find_ffmpeg();
     if (ffmpeg.empty())
-      fail("ffmpeg not found on PATH: install it (apt-get install ffmpeg) or pass --no-video to "
-           "write only the PNG frames");
+      fail(
+          "ffmpeg not found on PATH: install it (apt-get install ffmpeg) or pass --no-video to "
+          "write only the PNG frames");
     if (mp4.empty())
       mp4 = (std::filesystem::path(a.output_dir) /
              (std::filesystem::path(a.scene).stem().string() + ".mp4"))
@@ -130,13 +134,29 @@ int run_animate(const GlobalOptions& g, const AnimateArgs& a) {
     const double fps = session.scene().animation ? session.scene().animation->fps : 24.0;
     // Temp file + rename, like every other output; yuv420p needs even sizes (pad by one pixel).
     write_atomically(mp4, [&](const std::filesystem::path& tmp) {
-      const int rc = run_process({ffmpeg, "-nostdin", "-hide_banner", "-loglevel", "error", "-y",
-                                  "-framerate", fmt::format("{}", fps), "-start_number",
-                                  std::to_string(first), "-i",
-                                  (dir / "frame_%04d.png").string(), "-frames:v",
-                                  std::to_string(last - first + 1), "-vf",
-                                  "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt",
-                                  "yuv420p", "-f", "mp4", tmp.string()});
+      const int rc = run_process({ffmpeg,
+                                  "-nostdin",
+                                  "-hide_banner",
+                                  "-loglevel",
+                                  "error",
+                                  "-y",
+                                  "-framerate",
+                                  fmt::format("{}", fps),
+                                  "-start_number",
+                                  std::to_string(first),
+                                  "-i",
+                                  (dir / "frame_%04d.png").string(),
+                                  "-frames:v",
+                                  std::to_string(last - first + 1),
+                                  "-vf",
+                                  "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                  "-c:v",
+                                  "libx264",
+                                  "-pix_fmt",
+                                  "yuv420p",
+                                  "-f",
+                                  "mp4",
+                                  tmp.string()});
       if (rc != 0) fail_at(mp4, "ffmpeg failed (exit status {})", rc);
     });
     progress.tick();

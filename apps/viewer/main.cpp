@@ -1,7 +1,7 @@
 // follicle-viewer SCENE [--screenshot out.png [--frames N] [--with-ui]] [--size WxH]
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 
@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
                  "batch mode: draw --frames frames, save the view to this PNG and exit");
   app.add_option("--frames", opt.frames, "frames to draw before the batch screenshot")
       ->check(CLI::Range(1, 100000));
-  app.add_flag("--with-ui", opt.screenshot_ui, "batch screenshot of the whole window with the panel");
+  app.add_flag("--with-ui", opt.screenshot_ui,
+               "batch screenshot of the whole window with the panel");
   app.add_option("--width", opt.width, "window width")->check(CLI::Range(400, 16384));
   app.add_option("--height", opt.height, "window height")->check(CLI::Range(200, 16384));
   app.add_option("-j,--threads", opt.threads, "CPU threads (0 = all)")->check(CLI::Range(0, 1024));

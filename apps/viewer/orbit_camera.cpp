@@ -30,8 +30,7 @@ void OrbitCamera::set_from(const render::Camera& cam) {
 
 Vec3 OrbitCamera::eye() const {
   const double c = std::cos(m_pitch);
-  const Vec3 dir =
-      c * (std::cos(m_yaw) * m_a + std::sin(m_yaw) * m_b) + std::sin(m_pitch) * m_up;
+  const Vec3 dir = c * (std::cos(m_yaw) * m_a + std::sin(m_yaw) * m_b) + std::sin(m_pitch) * m_up;
   return m_target + m_distance * dir;
 }
 

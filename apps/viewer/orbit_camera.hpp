@@ -36,7 +36,7 @@ class OrbitCamera {
   double pitch() const { return m_pitch; }  // [rad]
   Vec3 eye() const;
 
-  static constexpr double kMaxPitch = 1.55;        // [rad], just under 90 degrees
+  static constexpr double kMaxPitch = 1.55;  // [rad], just under 90 degrees
   static constexpr double kRadiansPerPixel = 0.008;
   static constexpr double kZoomStep = 1.15;
 

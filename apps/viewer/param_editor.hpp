@@ -62,6 +62,16 @@ class ParamEditor {
     if (*info.unit) (f += " ") += info.unit;
     return f;
   }
+  /// A logarithmic slider for ranges over several decades (clip planes, light intensity
+  /// 0..100, shadow map size), so the usual values are not squeezed into the first pixels.
+  static ImGuiSliderFlags slider_flags(double lo, double hi) {
+    const bool decades = lo > 0 ? hi / lo >= 1000 : (lo == 0 && hi >= 50);
+    return (decades ? ImGuiSliderFlags_Logarithmic : ImGuiSliderFlags_None) |
+           ImGuiSliderFlags_AlwaysClamp;
+  }
+  static std::string fmt_label(const char* name, const char* unit) {
+    return std::string(name) + " [" + unit + "]";
+  }
   static bool looks_like_color(std::string_view name, const ParamInfo& info) {
     const bool unit_range = info.min == 0.0 && info.max == 1.0;
     return unit_range && (name.ends_with("color") || name == "background" || name == "rho_d");
@@ -78,11 +88,8 @@ class ParamEditor {
       const std::string fmt = number_format(info, "%.4g");
       if (finite_range(info)) {
         const double lo = info.min, hi = info.max;
-        // A logarithmic slider for ranges over several decades (near/far planes, stiffness...).
-        const ImGuiSliderFlags flags =
-            (lo > 0 && hi / lo > 1000) ? ImGuiSliderFlags_Logarithmic : ImGuiSliderFlags_None;
-        ch = ImGui::SliderScalar(name, ImGuiDataType_Double, &v, &lo, &hi, fmt.c_str(),
-                                 flags | ImGuiSliderFlags_AlwaysClamp);
+        const ImGuiSliderFlags flags = slider_flags(lo, hi);
+        ch = ImGui::SliderScalar(name, ImGuiDataType_Double, &v, &lo, &hi, fmt.c_str(), flags);
       } else {
         const double speed = std::max(1e-4, std::abs(v) * 0.01);
         const double lo = std::isfinite(info.min) ? info.min : -1e300;
@@ -102,10 +109,8 @@ class ParamEditor {
       const int64_t hi = std::isfinite(info.max) ? int64_t(std::floor(info.max)) : type_hi;
       const std::string fmt = number_format(info, "%lld");
       if (finite_range(info)) {
-        const ImGuiSliderFlags flags =
-            (lo > 0 && hi / lo > 1000) ? ImGuiSliderFlags_Logarithmic : ImGuiSliderFlags_None;
-        ch = ImGui::SliderScalar(name, ImGuiDataType_S64, &v, &lo, &hi, fmt.c_str(),
-                                 flags | ImGuiSliderFlags_AlwaysClamp);
+        const ImGuiSliderFlags flags = slider_flags(double(lo), double(hi));
+        ch = ImGui::SliderScalar(name, ImGuiDataType_S64, &v, &lo, &hi, fmt.c_str(), flags);
       } else {
         ch = ImGui::DragScalar(name, ImGuiDataType_S64, &v, 1.0f, &lo, &hi, fmt.c_str(),
                                ImGuiSliderFlags_AlwaysClamp);
@@ -123,9 +128,10 @@ class ParamEditor {
         const float hi = std::isfinite(info.max) ? float(info.max) : 0.0f;  // 0, 0 = unbounded
         float speed = 0.005f;
         for (int i = 0; i < n; ++i) speed = std::max(speed, 0.005f * std::abs(f[i]));
-        const std::string fmt = number_format(info, "%.4g");
-        ch = n == 3 ? ImGui::DragFloat3(name, f, speed, lo, hi, fmt.c_str())
-                    : ImGui::DragFloat2(name, f, speed, lo, hi, fmt.c_str());
+        // The unit goes into the label: three numbers plus units do not fit the fields.
+        const std::string label = *info.unit ? fmt_label(name, info.unit) : std::string(name);
+        ch = n == 3 ? ImGui::DragFloat3(label.c_str(), f, speed, lo, hi, "%.4g")
+                    : ImGui::DragFloat2(label.c_str(), f, speed, lo, hi, "%.4g");
       }
       tooltip(info);
       if (ch)
@@ -153,7 +159,7 @@ class ParamEditor {
         ImGui::EndCombo();
       }
       tooltip(info);
-    } else if constexpr (requires(T& t, ParamEditor& ed) { t.visit(ed); }) {
+    } else if constexpr (requires(T & t, ParamEditor & ed) { t.visit(ed); }) {
       if (ImGui::TreeNodeEx(name, ImGuiTreeNodeFlags_None)) {
         tooltip(info);
         ParamEditor inner(m_hidden);

@@ -2,10 +2,10 @@
 
 #define GLFW_INCLUDE_GLCOREARB
 #include <GLFW/glfw3.h>
-#include <fmt/format.h>
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <fmt/format.h>
+#include <imgui.h>
 
 #include <algorithm>
 #include <chrono>
@@ -36,7 +36,9 @@ constexpr double kPollSeconds = 0.5;  // scene file mtime poll interval
 /// Frames in the scene's animation (1 = static). Scene files have no animation section yet;
 /// when one is added, return its frame count here and the frame slider, Space and Left/Right
 /// come alive (Session::render_scene(frame) already takes the frame).
-int scene_frame_count(const scene::Scene& /*scene*/) { return 1; }
+int scene_frame_count(const scene::Scene& /*scene*/) {
+  return 1;
+}
 
 bool same_camera(const scene::CameraSpec& a, const scene::CameraSpec& b) {
   return a.eye == b.eye && a.target == b.target && a.up == b.up && a.fov_deg == b.fov_deg &&
@@ -77,9 +79,21 @@ double now_seconds() {
   return std::chrono::duration<double>(clock::now().time_since_epoch()).count();
 }
 
+/// A key press (or auto-repeat) with its modifiers, as GLFW reported it.
+struct KeyPress {
+  int key;
+  int mods;
+  bool repeat;
+};
+
 /// GLFW needs process-wide init/terminate; this owns it and the window for one run.
+/// Key presses are queued by our own callback (installed before ImGui's, which chains it):
+/// ImGui 1.86 keeps only a per-frame "key down" state, so a press and release between two
+/// frames (xdotool, fast typing while a frame renders) would otherwise be lost, and Shift
+/// could be released before the frame sees "S".
 struct GlfwWindow {
   GLFWwindow* window = nullptr;
+  std::vector<KeyPress> keys;
   GlfwWindow(int w, int h, const std::string& title, bool visible) {
     glfwSetErrorCallback([](int code, const char* msg) {
       fmt::print(stderr, "follicle-viewer: GLFW error {}: {}\n", code, msg);
@@ -97,6 +111,11 @@ struct GlfwWindow {
       fail("cannot create a {}x{} window with an OpenGL 3.3 core context", w, h);
     }
     glfwMakeContextCurrent(window);
+    glfwSetWindowUserPointer(window, this);
+    glfwSetKeyCallback(window, [](GLFWwindow* win, int key, int, int action, int mods) {
+      auto* self = static_cast<GlfwWindow*>(glfwGetWindowUserPointer(win));
+      if (self && action != GLFW_RELEASE) self->keys.push_back({key, mods, action == GLFW_REPEAT});
+    });
   }
   ~GlfwWindow() {
     glfwDestroyWindow(window);
@@ -143,8 +162,7 @@ class Viewer {
   explicit Viewer(const ViewerOptions& opt)
       : m_opt(opt),
         m_ctx(opt.threads, 1),
-        m_window(opt.width, opt.height, "Follicle viewer - " + opt.scene.filename().string(),
-                 true),
+        m_window(opt.width, opt.height, "Follicle viewer - " + opt.scene.filename().string(), true),
         m_imgui(m_window.window) {
     m_renderer = render::Renderer::create_with_current_context(m_ctx);
     m_device = m_renderer->device_description();
@@ -267,10 +285,10 @@ class Viewer {
 
   void handle_input() {
     ImGuiIO& io = ImGui::GetIO();
-    const bool any_input = io.MouseDelta.x != 0 || io.MouseDelta.y != 0 || io.MouseWheel != 0 ||
-                           ImGui::IsAnyMouseDown() || !io.InputQueueCharacters.empty() ||
-                           std::any_of(std::begin(io.KeysDown), std::end(io.KeysDown),
-                                       [](bool k) { return k; });
+    const bool any_input =
+        io.MouseDelta.x != 0 || io.MouseDelta.y != 0 || io.MouseWheel != 0 ||
+        ImGui::IsAnyMouseDown() || !io.InputQueueCharacters.empty() ||
+        std::any_of(std::begin(io.KeysDown), std::end(io.KeysDown), [](bool k) { return k; });
     m_idle_frames = any_input ? 0 : m_idle_frames + 1;
     m_moving = false;
     const float view_w = io.DisplaySize.x - kPanelWidth;
@@ -291,15 +309,22 @@ class Viewer {
         m_moving = true;
       }
     }
-    if (!io.WantCaptureKeyboard) {
-      if (ImGui::IsKeyPressed(GLFW_KEY_R, false)) reset_camera();
-      if (ImGui::IsKeyPressed(GLFW_KEY_F, false)) frame_all();
-      if (ImGui::IsKeyPressed(GLFW_KEY_S, false)) m_shot = io.KeyShift ? Shot::Window : Shot::View;
-      if (ImGui::IsKeyPressed(GLFW_KEY_SPACE, false)) toggle_play();
-      if (ImGui::IsKeyPressed(GLFW_KEY_LEFT, true)) step_frame(-1);
-      if (ImGui::IsKeyPressed(GLFW_KEY_RIGHT, true)) step_frame(+1);
-      if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false))
-        glfwSetWindowShouldClose(m_window.window, GLFW_TRUE);
+    std::vector<KeyPress> keys;
+    keys.swap(m_window.keys);
+    if (!keys.empty()) m_idle_frames = 0;
+    if (io.WantCaptureKeyboard) keys.clear();  // typing into a panel field
+    for (const KeyPress& k : keys) {
+      if (k.repeat && k.key != GLFW_KEY_LEFT && k.key != GLFW_KEY_RIGHT) continue;
+      switch (k.key) {
+        case GLFW_KEY_R: reset_camera(); break;
+        case GLFW_KEY_F: frame_all(); break;
+        case GLFW_KEY_S: m_shot = (k.mods & GLFW_MOD_SHIFT) ? Shot::Window : Shot::View; break;
+        case GLFW_KEY_SPACE: toggle_play(); break;
+        case GLFW_KEY_LEFT: step_frame(-1); break;
+        case GLFW_KEY_RIGHT: step_frame(+1); break;
+        case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(m_window.window, GLFW_TRUE); break;
+        default: break;
+      }
     }
     if (m_moving) m_dirty = true;
   }
@@ -399,8 +424,13 @@ class Viewer {
     glfwGetFramebufferSize(m_window.window, &fb_w, &fb_h);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fb_w, fb_h);
-    const Vec3 bg = m_session ? m_session->scene().render.background : Vec3(0.1, 0.1, 0.1);
-    glClearColor(float(bg.x()), float(bg.y()), float(bg.z()), 1.0f);
+    // The renderer's output is sRGB-encoded; clear the margin (before the first image) to match.
+    const Vec3 bg = m_session ? m_session->scene().render.background : Vec3(0.01, 0.01, 0.01);
+    const auto srgb = [](double c) {
+      c = std::clamp(c, 0.0, 1.0);
+      return float(c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055);
+    };
+    glClearColor(srgb(bg.x()), srgb(bg.y()), srgb(bg.z()), 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
     if (m_has_image) {
       glBindFramebuffer(GL_READ_FRAMEBUFFER, m_fbo);
@@ -449,8 +479,8 @@ class Viewer {
     ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - kPanelWidth, 0));
     ImGui::SetNextWindowSize(ImVec2(kPanelWidth, io.DisplaySize.y));
     ImGui::Begin("Follicle", nullptr,
-                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
-                     ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings);
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                     ImGuiWindowFlags_NoSavedSettings);
     ImGui::PushItemWidth(-150.0f);  // room for the labels
 
     ImGui::TextDisabled("Scene");
@@ -526,7 +556,8 @@ class Viewer {
     if (lights.empty()) ImGui::TextDisabled("no lights (ambient only)");
     for (std::size_t i = 0; i < lights.size(); ++i) {
       ImGui::PushID(int(i));
-      const std::string label = lights[i].name.empty() ? fmt::format("light {}", i) : lights[i].name;
+      const std::string label =
+          lights[i].name.empty() ? fmt::format("light {}", i) : lights[i].name;
       const auto before = m_session->scene();
       auto& l = lights[i];
       bool ch = false;

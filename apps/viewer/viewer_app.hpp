@@ -21,5 +21,4 @@ struct ViewerOptions {
 /// follicle::Error when no window/GL 3.3 context can be made.
 int run_viewer(const ViewerOptions& opt);
 
-
 }  // namespace follicle::viewer

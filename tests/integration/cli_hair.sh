@@ -77,7 +77,7 @@ PATH=/nonexistent "$FOLLICLE" animate "$TMP/wind.json" --frames 0-0 -o "$TMP/ani
 # Bad hair keys: exit 1, one line naming the JSON path.
 python3 - "$TMP/bob.json" "$TMP/bad.json" <<'PY'
 import json, sys
-s = json.load(open(sys.argv[1])); s["hair"][0]["dynamics"]["stifness_deg"] = 10
+s = json.load(open(sys.argv[1])); s["hair"][0]["dynamics"] = {"stifness_deg": 10}
 json.dump(s, open(sys.argv[2], "w"))
 PY
 "$FOLLICLE" validate "$TMP/bad.json" 2>"$TMP/err"

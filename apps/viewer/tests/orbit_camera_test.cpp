@@ -1,12 +1,13 @@
 // OrbitCamera: round trips with render::Camera, and what a drag does on screen (checked by
 // projecting points with the renderer's own camera maths).
+#include "orbit_camera.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "follicle/core/error.hpp"
 #include "follicle/render/camera.hpp"
-#include "orbit_camera.hpp"
 
 namespace follicle::viewer {
 namespace {

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -258,6 +259,33 @@ SubMesh extract_hand(const MakeHumanBase& base, const Skeleton& skel, const Skin
   // hand island at v < 0.2); its UVs would stretch the bounding box used for the rescale below
   // and shrink the hand to a small part of the texture.
   std::vector<char> face_in(base.faces.size(), 0);
+  // A face whose corners lie in two charts (its texture edge is many times longer, relative to
+  // its 3D edge, than is typical) joins the charts in the connectivity below: drop it first.
+  {
+    std::vector<double> ratio;
+    std::vector<double> face_ratio(base.faces.size(), 0.0);
+    for (std::size_t f = 0; f < base.faces.size(); ++f) {
+      const Vec3i& F = base.faces[f];
+      if (!in[F[0]] || !in[F[1]] || !in[F[2]]) continue;
+      const Vec3i& T = base.uv_faces[f];
+      double worst = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double l3 = (base.positions[F[(c + 1) % 3]] - base.positions[F[c]]).norm();
+        const double lt = (base.uvs[T[(c + 1) % 3]] - base.uvs[T[c]]).norm();
+        const double q = l3 > 0 ? lt / l3 : std::numeric_limits<double>::infinity();
+        ratio.push_back(q);
+        worst = std::max(worst, q);
+      }
+      face_ratio[f] = worst;
+      face_in[f] = 1;
+    }
+    if (!ratio.empty()) {
+      std::nth_element(ratio.begin(), ratio.begin() + ratio.size() / 2, ratio.end());
+      const double median = ratio[ratio.size() / 2];
+      for (std::size_t f = 0; f < base.faces.size(); ++f)
+        if (face_in[f] && !(face_ratio[f] <= 8.0 * median)) face_in[f] = 0;
+    }
+  }
   {
     std::vector<int> parent(base.uvs.size());
     for (std::size_t t = 0; t < parent.size(); ++t) parent[t] = int(t);
@@ -266,9 +294,7 @@ SubMesh extract_hand(const MakeHumanBase& base, const Skeleton& skel, const Skin
       return a;
     };
     for (std::size_t f = 0; f < base.faces.size(); ++f) {
-      const Vec3i& F = base.faces[f];
-      if (!in[F[0]] || !in[F[1]] || !in[F[2]]) continue;
-      face_in[f] = 1;
+      if (!face_in[f]) continue;
       const Vec3i& T = base.uv_faces[f];
       for (int c = 1; c < 3; ++c) parent[find(T[c])] = find(T[0]);
     }
@@ -322,28 +348,29 @@ Pose finger_flexion_pose(const Skeleton& skel, Side side, double flexion, double
   Pose p = Pose::rest(skel);
   const std::string suffix = side == Side::left ? ".L" : ".R";
   const auto& bones = skel.bones();
+  // Palm normal from the skeleton: F = wrist -> middle finger base, T = little -> index finger
+  // base (toward the thumb); for a left hand the palm faces F x T, for a right hand T x F.
+  // (The rest fingers of hm08 are not reliably curled toward the palm: the joint centres of the
+  // middle finger lie slightly on the back side of the line from its base to its tip, so the
+  // rest curl cannot fix the sign.)
+  const int wrist = skel.find("wrist" + suffix);
+  const int mid = skel.find("finger3-1" + suffix);
+  const int index = skel.find("finger2-1" + suffix);
+  const int little = skel.find("finger5-1" + suffix);
+  if (wrist < 0 || mid < 0 || index < 0 || little < 0)
+    fail("finger_flexion_pose: the skeleton has no wrist{0}/finger2-1{0}/finger3-1{0}/finger5-1{0}",
+         suffix);
+  const Vec3 F = bones[mid].head - bones[wrist].head;
+  const Vec3 T = bones[index].head - bones[little].head;
+  const Vec3 palm = side == Side::left ? F.cross(T) : T.cross(F);
   for (int f = 1; f <= 5; ++f) {
-    const int b1 = skel.find(fmt::format("finger{}-1{}", f, suffix));
-    const int b3 = skel.find(fmt::format("finger{}-3{}", f, suffix));
-    if (b1 < 0 || b3 < 0) continue;
-    // The rest fingers are slightly curled toward the palm: the middle joints lie off the line
-    // from the first head to the last tail on the palm side. Flexion increases that curl, which
-    // fixes the sign of the rotation about each bone's x axis without assuming a handedness.
-    const Vec3 a = bones[b1].head, e = bones[b3].tail;
-    const Vec3 axis_line = (e - a).normalized();
-    Vec3 curl = Vec3::Zero();
-    for (int k = 2; k <= 3; ++k) {
-      const int b = skel.find(fmt::format("finger{}-{}{}", f, k, suffix));
-      if (b < 0) continue;
-      const Vec3 d = bones[b].head - a;
-      curl += d - axis_line * axis_line.dot(d);
-    }
     for (int k = 1; k <= 3; ++k) {
       const int b = skel.find(fmt::format("finger{}-{}{}", f, k, suffix));
       if (b < 0) continue;
+      // Fingers curl toward the palm: the tail moves along +palm.
       const Vec3 x = bones[b].frame.col(0);
       const Vec3 motion = x.cross(bones[b].tail - bones[b].head);
-      const double sign = motion.dot(curl) >= 0 ? 1.0 : -1.0;
+      const double sign = motion.dot(palm) >= 0 ? 1.0 : -1.0;
       const double angle = flexion * max_angle * (f == 1 ? 0.5 : 1.0);
       p.rotate(b, 0, sign * angle);
     }

@@ -42,13 +42,18 @@ Vec3 avoid_hull_in_plane(const sim::Ellipsoid& hull, const Vec3& p_prev2, const 
   w.normalize();
   auto at = [&](double t) { return Vec3(p_prev + d * (std::cos(t) * u + std::sin(t) * w)); };
   // Smallest rotation angle that gets out: coarse scan, then bisection.
+  // The scan rotates (cos t, sin t) by a fixed step (no trigonometric call per sample).
   constexpr int kSteps = 48;
-  double lo = 0.0;
+  const double cstep = std::cos(kPi / kSteps), sstep = std::sin(kPi / kSteps);
+  double c = 1.0, sn = 0.0, lo = 0.0;
   for (int s = 1; s <= kSteps; ++s) {
     const double t = kPi * s / kSteps;
-    if (hull.value(at(t)) >= 0.0) {
+    const double c2 = c * cstep - sn * sstep;
+    sn = sn * cstep + c * sstep;
+    c = c2;
+    if (hull.value(Vec3(p_prev + d * (c * u + sn * w))) >= 0.0) {
       double hi = t;
-      for (int it = 0; it < 30; ++it) {
+      for (int it = 0; it < 22; ++it) {  // 22 halvings of π/48: below 1e-8 rad
         const double mid = 0.5 * (lo + hi);
         (hull.value(at(mid)) >= 0.0 ? hi : lo) = mid;
       }

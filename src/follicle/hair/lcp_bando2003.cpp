@@ -1,11 +1,11 @@
 #include "follicle/hair/lcp_bando2003.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <unordered_map>
-
-#include <spdlog/spdlog.h>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -16,6 +16,7 @@ namespace follicle::hair {
 
 namespace {
 constexpr double kOrphanAlignment = 0.1;  // a_ij floor of a forced root-side connection
+constexpr double kTetherFraction = 0.95;  // a lone root-side spring keeps k = c W(h_s, 0.95 2h_s)
 }  // namespace
 
 void LcpInitParams::validate() const {
@@ -453,6 +454,29 @@ void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace&
     const double d = (s.x[m.pair_b[q]] - s.x[m.pair_a[q]]).norm();
     ws.k[q] = m.c[q] * sph_w(m.h_s, d);  // (3.7) k_ij = c_ij W(h_s, |x_ij|)
   });
+  // A particle whose root-side springs have all drawn apart beyond 2 h_s would be free and fall
+  // off the head. Its nearest root-side spring is kept at the coefficient it has at r = 2 h_s
+  // minus a margin (any positive k gives the full tensile modulus through (3.13)), so the hair
+  // splits laterally but never tears lengthwise (not in the paper; see docs/equations/lcp.md).
+  // Each connection has exactly one tip-side end, so writing k[q] for pairs with pair_b == i is
+  // race-free.
+  const double k_floor_w = sph_w(m.h_s, kTetherFraction * 2 * m.h_s);
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    if (m.root[i]) return;
+    uint32_t best = uint32_t(-1);
+    double bd = 1e300;
+    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+      const uint32_t q = m.adj_pairs[e];
+      if (m.pair_b[q] != i) continue;
+      if (ws.k[q] > 0) return;
+      const double d = (s.x[m.pair_a[q]] - s.x[i]).squaredNorm();
+      if (d < bd) {
+        bd = d;
+        best = q;
+      }
+    }
+    if (best != uint32_t(-1)) ws.k[best] = m.c[best] * k_floor_w;
+  });
   const double E = m_params.elastic_modulus;
   parallel_for(ctx, 0, n, [&](std::size_t i) {
     double sr = 0, st = 0;
@@ -677,7 +701,11 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
           return w;
         },
         [](double a, double b) { return std::max(a, b); });
-    const double need = std::ceil(in.dt * std::sqrt(w2) / m_params.cfl);
+    // The explicit hair-hair damping (3.17)/(3.18) needs d dt < 1 as well (per reduced mass).
+    const double rate = std::max(
+        std::sqrt(w2),
+        m_params.hair_hair ? std::max(m_params.collision_damping, m_params.friction_damping) : 0.0);
+    const double need = std::ceil(in.dt * rate / m_params.cfl);
     if (std::isfinite(need))
       nsub = std::max(nsub, int(std::min<double>(need, m_params.max_substeps)));
   }
@@ -766,12 +794,15 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
         });
     rep.max_speed = chk.vmax;
     if (chk.bad != SIZE_MAX) {
-      rep.ok = false;
-      rep.bad_particle = chk.bad;
+      const double sp = s.v[chk.bad].norm();
+      if (std::isfinite(sp) && s.x[chk.bad].allFinite() && s.t[chk.bad].allFinite())
+        rep.mark_blow_up(chk.bad);
+      else
+        rep.mark_non_finite(chk.bad);
       rep.message = fmt::format(
-          "blow-up at t = {:.5f} s: particle {} has speed {} m/s (limit {} m/s) or a non-finite "
-          "value; reduce the time step or the stiffness",
-          s.time, chk.bad, s.v[chk.bad].norm(), vlim);
+          "lcp: blow-up at t = {:.5f} s: particle {} has speed {} m/s (limit {} m/s) or a "
+          "non-finite value; reduce the time step or the stiffness",
+          s.time, chk.bad, sp, vlim);
       return rep;
     }
   }

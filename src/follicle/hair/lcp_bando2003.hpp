@@ -17,6 +17,7 @@
 #include "follicle/core/types.hpp"
 #include "follicle/hair/particle_grid.hpp"
 #include "follicle/hair/scalp_bando2003.hpp"
+#include "follicle/sim/step_report.hpp"
 #include "follicle/sim/voxel_planes.hpp"
 
 namespace follicle::hair {
@@ -66,20 +67,20 @@ struct LcpParams {
   int max_substeps = 2000;          // cap of the adaptive sub-step count
   Vec3 gravity{0, -9.81, 0};        // [m/s^2] world frame
   double air_drag = 0.6;            // [1/s] drag per unit mass against still air
-  double elastic_modulus = 4000;    // E [Pa] of (3.10)/(3.11), kept constant per particle
+  double elastic_modulus = 40000;   // E [Pa] of (3.10)/(3.11), kept constant per particle
   double material_density = 1300;   // delta [kg/m^3] of (3.9)
   double spring_damping = 0.5;      // damping ratio of each loose spring
   double compression_scale = 0.25;  // scales compressed springs: bending vs tensile stiffness
   int alpha_sweeps = 0;             // balancing sweeps after (3.14) (0 = the paper: average only)
   bool hair_hair = true;            // §3.3.3 on/off (Fig. 3.7 c vs d)
-  double k_a = 0.5;                 // [m^2/s^2] (3.16) pressure constant, P = k_a (rho - rho0)
-  double rho0_scale = 1.0;          // rho0 = rho0_scale * mean rest density (< 1 repulsive)
-  double collision_damping = 40;    // d_c of (3.17), per reduced mass [1/s] (see .cpp)
-  double friction_damping = 4;      // d_f of (3.18), per reduced mass [1/s]
-  double colinear_eps = 0.2;        // |t_i x t_j| below this: near-colinear collision direction
-  bool body_collision = true;       // §3.5 on/off (needs voxel planes)
-  sim::BodyContactParams contact;   // (3.19)-(3.24)
-  double max_speed = 30;            // [m/s] a faster particle is reported as a blow-up
+  double k_a = 5.0;                // [m^2/s^2] (3.16) P = k_a (rho - rho0); sqrt(k_a) = sound speed
+  double rho0_scale = 1.0;         // rho0 = rho0_scale * mean rest density (< 1 repulsive)
+  double collision_damping = 400;  // d_c of (3.17), per reduced mass [1/s] (see .cpp)
+  double friction_damping = 4;     // d_f of (3.18), per reduced mass [1/s]
+  double colinear_eps = 0.2;       // |t_i x t_j| below this: near-colinear collision direction
+  bool body_collision = true;      // §3.5 on/off (needs voxel planes)
+  sim::BodyContactParams contact;  // (3.19)-(3.24)
+  double max_speed = 30;           // [m/s] a faster particle is reported as a blow-up
   template <class V>
   void visit(V&& v) {
     v("substeps", substeps, ParamInfo{"minimum sub-steps per step", "", 1, 10000});
@@ -135,13 +136,11 @@ struct LcpState {
   double time = 0;
 };
 
-/// What step() reports (the simulation never throws on divergence).
-struct LcpStepReport {
-  bool ok = true;
-  std::string message;           // why not ok
-  std::size_t bad_particle = 0;  // first offending particle when !ok
+/// What step() reports (the simulation never throws on divergence): the shared sim::StepReport
+/// (ok, non_finite, blow_up, max_speed [m/s, head frame], first_bad particle, message) plus the
+/// LCP specifics.
+struct LcpStepReport : sim::StepReport {
   int substeps = 0;              // sub-steps taken
-  double max_speed = 0;          // [m/s] head frame, at the end
   double max_penetration = 0;    // [m] deepest particle below a body plane (>= 0)
   std::size_t num_contacts = 0;  // particles in contact at the last sub-step
 };

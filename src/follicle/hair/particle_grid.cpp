@@ -23,7 +23,14 @@ void ParticleGrid::build(const std::vector<Vec3>& points, double cell) {
   for (std::size_t b = 0; b < nb; ++b) m_start[b + 1] += m_start[b];
   m_sorted.resize(points.size());
   std::vector<uint32_t> fill(m_start.begin(), m_start.end() - 1);
-  for (std::size_t i = 0; i < points.size(); ++i) m_sorted[fill[m_bucket_of[i]]++] = uint32_t(i);
+  m_cell_sorted.resize(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const uint32_t slot = fill[m_bucket_of[i]]++;
+    m_sorted[slot] = uint32_t(i);
+    const Vec3& p = points[i];
+    m_cell_sorted[slot] = {int(std::floor(p.x() * m_inv)), int(std::floor(p.y() * m_inv)),
+                           int(std::floor(p.z() * m_inv))};
+  }
 }
 
 namespace {

@@ -4,6 +4,7 @@
 // fixed order that does not depend on the thread count and (b) a rebuild every time step without
 // allocation. Cells are hashed into a table (2 x points, power of two) and points are counting-
 // sorted by bucket, stably by index: the neighbour order is a pure function of the positions.
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -25,17 +26,17 @@ class ParticleGrid {
     if (m_mask == 0 && m_start.empty()) return;
     const int cx = int(std::floor(p.x() * m_inv)), cy = int(std::floor(p.y() * m_inv)),
               cz = int(std::floor(p.z() * m_inv));
-    uint32_t seen[27];
-    int nseen = 0;
+    // Points are accepted only in their own cell, so a bucket shared by two of the 27 cells
+    // (hash collision) is not visited twice and far points sharing a bucket are skipped early.
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
-          const uint32_t b = bucket(cx + dx, cy + dy, cz + dz);
-          bool dup = false;
-          for (int k = 0; k < nseen; ++k) dup = dup || seen[k] == b;
-          if (dup) continue;  // two cells hashed to one bucket: visit it once
-          seen[nseen++] = b;
-          for (uint32_t s = m_start[b]; s < m_start[b + 1]; ++s) f(m_sorted[s]);
+          const int x = cx + dx, y = cy + dy, z = cz + dz;
+          const uint32_t b = bucket(x, y, z);
+          for (uint32_t s = m_start[b]; s < m_start[b + 1]; ++s) {
+            const auto& c = m_cell_sorted[s];
+            if (c[0] == x && c[1] == y && c[2] == z) f(m_sorted[s]);
+          }
         }
   }
 
@@ -60,6 +61,7 @@ class ParticleGrid {
   std::vector<uint32_t> m_start;   // bucket -> first slot, size buckets + 1
   std::vector<uint32_t> m_sorted;  // point indices by bucket
   std::vector<uint32_t> m_bucket_of;
+  std::vector<std::array<int, 3>> m_cell_sorted;  // integer cell of each sorted point
 };
 
 }  // namespace follicle::hair

@@ -83,6 +83,14 @@ HairStyle bob(double ds) {
   return st;
 }
 
+ForceField radial(double strength, const PolarRange& pores) {
+  ForceField f;
+  f.kind = "radial";
+  f.strength = strength;
+  f.pores = pores;
+  return f;
+}
+
 HairStyle swept_back(double ds) {
   HairStyle st;
   st.name = "swept_back";
@@ -92,9 +100,24 @@ HairStyle swept_back(double ds) {
   main.pores = scalp(dens, 0.2, 0.06);
   main.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.2, 0.06));
   main.beam.flexural_rigidity = 5e-9;
-  // Force from the face backwards (Fig. 6b) on the segments above the eyes.
-  main.fields.push_back(uniform({0.0, 1.0, -7.0}, polar(-kPi, kPi), 0.05));
-  main.cuts.push_back(cut_below(-1.2));
+  // Fig. 6b: the force points from the face backwards on the segments above the ears; with
+  // gravity the hair leaves the forehead, runs back along the head over the crown (the hull
+  // collision keeps it on the head) and falls down the back.
+  // In front of the crown the force also lifts (its component along the forehead must point
+  // up and back, not down the face).
+  main.fields.push_back(uniform({0.0, 0.0, -8.0}, polar(-2.2, 2.2), -0.8));
+  ForceField lift = uniform({0.0, 8.0, -10.0}, polar(-2.2, 2.2));
+  lift.nodes.axis = Vec3::UnitZ();
+  lift.nodes.min = 0.0;
+  main.fields.push_back(lift);
+  main.beam.load_iterations = 2;
+  main.cuts.push_back(cut_below(-1.25));
+  // Nothing may fall over the face: cut where q_y - 2 q_z < -1.4 (in front of and below the
+  // front hairline, -1.2 there; the back of the head is far above).
+  CutRule face;
+  face.axis = Vec3(0.0, 1.0, -2.0);
+  face.threshold = -1.4;
+  main.cuts.push_back(face);
   HairPart tuft;  // the tuft at the side of the temple
   tuft.name = "temple_tuft";
   tuft.pores = {region(1.05, 1.35, 1.2, 1.5, dens * 1.5, 0.09, 0.1),
@@ -125,22 +148,26 @@ HairStyle ponytail(double ds) {
 HairStyle short_cut(double ds) {
   HairStyle st;
   st.name = "short_cut";
-  const double dens = 2.5e5 * ds;
+  const double dens = 3.0e5 * ds;
   HairPart main;
   main.name = "main";
-  main.pores = scalp(dens, 0.12, 0.05);
-  main.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.12, 0.05));
+  main.pores = scalp(dens, 0.09, 0.05);
+  main.pores.push_back(region(-0.75, 0.75, 0.45, 0.95, dens, 0.09, 0.05));
   main.beam.flexural_rigidity = 1.5e-9;
-  main.fields.push_back(uniform({0.0, 0.0, -5.0}, polar(-kPi, kPi), -0.2));
-  // Fig. 6d: how much is cut depends on the pore height: short at the nape, long on top.
+  // Short hair lies on the head: a pull towards the centre (the hull keeps it outside), combed
+  // back and down on the top and sides.
+  main.fields.push_back(radial(-30.0, polar(-kPi, kPi)));
+  main.fields.push_back(uniform({0.0, -3.0, -6.0}, polar(-kPi, kPi)));
+  // Fig. 6d: how much is cut depends on the pore height: short at the nape and above the ears,
+  // longer on top.
   CutRule c;
   c.kind = "height_length";
-  c.height_low = -0.45;
-  c.height_high = 0.9;
-  c.length_low = 0.015;
-  c.length_high = 0.085;
+  c.height_low = -0.2;
+  c.height_high = 0.85;
+  c.length_low = 0.012;
+  c.length_high = 0.07;
   main.cuts.push_back(c);
-  main.cuts.push_back(cut_below(0.45, polar(-0.8, 0.8)));  // fringe above the eyebrows
+  main.cuts.push_back(cut_below(0.5, polar(-0.8, 0.8)));  // fringe above the eyebrows
   st.parts = {main};
   return st;
 }

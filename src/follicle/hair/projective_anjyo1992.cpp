@@ -1,17 +1,16 @@
 #include "follicle/hair/projective_anjyo1992.hpp"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
-
-#include <Eigen/Core>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
 #include "follicle/core/params.hpp"
 #include "follicle/core/rng.hpp"
 
-long g_pole = 0, g_clamp = 0;
 namespace follicle::hair {
 
 void ProjectiveParams::validate() const {
@@ -149,25 +148,160 @@ struct Scratch {
   float inc_t[kChunk], inc_p[kChunk];        // Δt² c u F_θ, Δt² c v F_φ
   float dx[kChunk], dy[kChunk], dz[kChunk];  // old direction of s_i
   float nx[kChunk], ny[kChunk], nz[kChunk];  // new direction of s_i
-  float vm[kChunk];  // largest squared speed of the strand's nodes
+  float vm[kChunk];                          // largest squared speed of the strand's nodes
+  float psth[kChunk], pcth[kChunk], psph[kChunk], pcph[kChunk];  // previous angles (pole)
+  double c[8][kChunk];                                           // gathered pole-case lanes
+  float len[kChunk], gain[kChunk], nsegf[kChunk];  // inputs copied in (padded to whole vectors)
+  float d0x[kChunk], d0y[kChunk], d0z[kChunk];
+  int list[kChunk];
   int flag[kChunk];
 };
 
-// Angle reduced to (-2π, 2π) for the single-precision sin/cos (φ may wind up over time); NaN and
-// huge values map to 0 (the double state keeps them, so blow-ups are still reported).
-inline float reduce_angle(double x) {
-  constexpr double inv2pi = 1.0 / (2.0 * kPi);
-  const double xc = (x > -1e9) & (x < 1e9) ? x : 0.0;
-  return float(xc - 2.0 * kPi * double(int(xc * inv2pi)) + (x - x));  // x - x: NaN for NaN/Inf
+// GCC/Clang vector extensions: 4 floats, portable SIMD for the block loops (plain loops with
+// selects are not auto-vectorised by GCC for SSE2).
+typedef float vf __attribute__((vector_size(16)));
+typedef int vi __attribute__((vector_size(16)));
+constexpr std::size_t kW = 4;
+inline vf ld(const float* p) {
+  vf v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void st4(float* p, const vf& v) {
+  std::memcpy(p, &v, sizeof v);
+}
+inline vf splat(float x) {
+  return vf{x, x, x, x};
 }
 
-// Vectorised sin/cos of n floats (Eigen's SIMD psin/pcos; hand-written loops with libm calls do
-// not vectorise).
+// sin and cos of n floats (n a multiple of kW; |x| <= ~1e3 as here, where angles are reduced to
+// [-π, π]) with one shared reduction to [-π/4, π/4] (3-part Cody-Waite) and the single-precision
+// minimax polynomials of Cephes sinf/cosf (about 1 ulp). Hand-written because neither libm nor
+// Eigen offers a fused vector sincos (Eigen's separate sin and cos took a third of the step).
 inline void sincos_block(const float* x, float* s, float* c, std::size_t n) {
-  using A = Eigen::Array<float, Eigen::Dynamic, 1>;
-  const Eigen::Map<const A> X(x, Eigen::Index(n));
-  Eigen::Map<A>(s, Eigen::Index(n)) = X.sin();
-  Eigen::Map<A>(c, Eigen::Index(n)) = X.cos();
+  constexpr float magic = 12582912.0f;  // 1.5 * 2^23: x + magic rounds x to an integer
+  for (std::size_t j = 0; j < n; j += kW) {
+    const vf v = ld(x + j);
+    const vf k = v * 0.636619772367581f + magic;  // 2/π
+    vi q;
+    std::memcpy(&q, &k, sizeof q);  // low mantissa bits of k: the quadrant
+    const vf kf = k - magic;
+    const vf r = ((v - kf * 1.5703125f) - kf * 4.837512969970703125e-4f) -
+                 kf * 7.54978995489188216e-8f;  // π/2 in three parts
+    const vf z = r * r;
+    const vf sp = r + r * z * (-1.6666654611e-1f + z * (8.3321608736e-3f + z * -1.9515295891e-4f));
+    const vf cp =
+        1.0f - 0.5f * z +
+        z * z * (4.166664568298827e-2f + z * (-1.388731625493765e-3f + z * 2.443315711809948e-5f));
+    const vi swap = (q & 1) != 0;
+    const vf sn = swap ? cp : sp, cs = swap ? sp : cp;
+    st4(s + j, (q & 2) != 0 ? -sn : sn);
+    st4(c + j, ((q + 1) & 2) != 0 ? -cs : cs);
+  }
+}
+typedef double vd __attribute__((vector_size(16)));
+constexpr std::size_t kWd = 2;
+inline vd ldd(const double* p) {
+  vd v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline vd splatd(double x) {
+  return vd{x, x};
+}
+inline vd sqrt_v(vd x) {
+  return vd{std::sqrt(x[0]), std::sqrt(x[1])};
+}
+inline vd abs_v(vd x) {
+  return x < 0.0 ? -x : x;
+}
+// atan2 by the minimax polynomial of Abramowitz & Stegun 4.4.49 (|error| <= 2e-8 rad), 2 lanes.
+inline vd atan2_v(vd y, vd x) {
+  const vd ax = abs_v(x), ay = abs_v(y);
+  const vd mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
+  const vd a = mn / (mx > 0.0 ? mx : splatd(1.0)), s = a * a;
+  vd r =
+      a *
+      (1.0 +
+       s * (-0.3333314528 +
+            s * (0.1999355085 +
+                 s * (-0.1420889944 +
+                      s * (0.1065626393 +
+                           s * (-0.0752896400 +
+                                s * (0.0429096138 + s * (-0.0161657367 + s * 0.0028662257))))))));
+  r = ay > ax ? 0.5 * kPi - r : r;
+  r = x < 0.0 ? kPi - r : r;
+  return y < 0.0 ? -r : r;
+}
+inline vd nearest_branch_v(vd phi, vd hint) {
+  constexpr double magic = 6755399441055744.0;  // rounds to nearest by two additions
+  const vd k = ((hint - phi) * (1.0 / (2.0 * kPi)) + magic) - magic;
+  return phi + 2.0 * kPi * k;
+}
+// direction_angles() for two directions at once (same branch rule).
+inline void direction_angles_v(vd x, vd y, vd z, vd hint, vd& theta, vd& phi) {
+  const vd h = sqrt_v(x * x + z * z);
+  const vd t1 = atan2_v(h, y), a = atan2_v(x, z);
+  const vd p1 = nearest_branch_v(a, hint), p2 = nearest_branch_v(a + kPi, hint);
+  const auto first = abs_v(p1 - hint) <= abs_v(p2 - hint);
+  const auto pole = h < 1e-12;
+  theta = pole ? (y >= 0.0 ? splatd(0.0) : splatd(kPi)) : (first ? t1 : -t1);
+  phi = pole ? hint : (first ? p1 : p2);
+}
+
+// Angle reduced to [-π, π] for the single-precision sin/cos (φ may wind up over time)
+// (k rounded by the 1.5 * 2^52 trick: pure additions, so the loop vectorises; NaN and Inf give
+// NaN.)
+inline float reduce_angle(double x) {
+  constexpr double inv2pi = 1.0 / (2.0 * kPi), magic = 6755399441055744.0;
+  const double k = (x * inv2pi + magic) - magic;
+  return float(x - 2.0 * kPi * k);
+}
+
+// atan2 by the minimax polynomial of Abramowitz & Stegun 4.4.49 (|error| <= 2e-8 rad on [0, 1]),
+// inline instead of libm because the hot fix-up loops call it for a third of all segments.
+inline double atan2_fast(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double mx = std::max(ax, ay), mn = std::min(ax, ay);
+  const double a = mx > 0 ? mn / mx : 0.0, s = a * a;
+  double r =
+      a *
+      (1.0 +
+       s * (-0.3333314528 +
+            s * (0.1999355085 +
+                 s * (-0.1420889944 +
+                      s * (0.1065626393 +
+                           s * (-0.0752896400 +
+                                s * (0.0429096138 + s * (-0.0161657367 + s * 0.0028662257))))))));
+  if (ay > ax) r = 0.5 * kPi - r;
+  if (x < 0) r = kPi - r;
+  return y < 0 ? -r : r;
+}
+
+inline double nearest_branch_fast(double phi, double hint) {
+  const double v = (hint - phi) * (1.0 / (2.0 * kPi));
+  const double k = (v > -1e9 && v < 1e9) ? double(int64_t(v + (v >= 0 ? 0.5 : -0.5))) : 0.0;
+  return phi + 2.0 * kPi * k;
+}
+
+// direction_angles() for a single-precision direction with the fast atan2 (same branch rule).
+inline void direction_angles_fast(double x, double y, double z, double phi_hint, double& theta,
+                                  double& phi) {
+  const double h = std::sqrt(x * x + z * z);
+  if (h < 1e-12) {
+    phi = phi_hint;
+    theta = y >= 0 ? 0.0 : kPi;
+    return;
+  }
+  const double t1 = atan2_fast(h, y), a = atan2_fast(x, z);
+  const double p1 = nearest_branch_fast(a, phi_hint), p2 = nearest_branch_fast(a + kPi, phi_hint);
+  if (std::abs(p1 - phi_hint) <= std::abs(p2 - phi_hint)) {
+    theta = t1;
+    phi = p1;
+  } else {
+    theta = -t1;
+    phi = p2;
+  }
 }
 
 }  // namespace
@@ -193,8 +327,6 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
   const bool fluct = m_p.fluctuation > 0 && st.step % uint64_t(m_p.fluctuation_interval) == 0;
   const double cos_sig_root = std::cos(m_p.stiffness_root_deg * kPi / 180.0);
   const double cos_sig = std::cos(m_p.stiffness_deg * kPi / 180.0);
-  const double sin_sig_root = std::sin(m_p.stiffness_root_deg * kPi / 180.0);
-  const double sin_sig = std::sin(m_p.stiffness_deg * kPi / 180.0);
   const double damp = 1.0 - m_p.damping * dt;
   const double alpha = m_p.alpha;
   // Hull in the head frame: q = M (p - c), M = diag(1/r) R^T; gradient ∝ R (q ./ r).
@@ -234,6 +366,14 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
       S.pdx[j] = S.pdy[j] = S.pdz[j] = 0.0f;
       S.vx[j] = S.vy[j] = S.vz[j] = 0.0f;
       S.vm[j] = 0.0f;
+      S.nsegf[j] = float(nseg[j]);
+    }
+    const std::size_t n4 = (n + kW - 1) / kW * kW;
+    for (std::size_t j = n; j < n4; ++j) {  // padding lanes: inactive, zero-length segments
+      S.px[j] = S.py[j] = S.pz[j] = 0.0f;
+      S.nsegf[j] = 0.0f;
+      S.len[j] = S.gain[j] = S.tf[j] = S.pf[j] = 0.0f;
+      S.d0x[j] = S.d0y[j] = S.d0z[j] = 0.0f;
     }
     for (std::size_t i = 1; i <= K; ++i) {
       const std::size_t row = (i - 1) * N + s0;
@@ -245,110 +385,144 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
       const float* gain = m_gainf.data() + row;
       const bool root_joint = int(i - 1) <= m_p.stiffness_root_segments;
       const double cs = root_joint ? cos_sig_root : cos_sig;
-      const double ss = root_joint ? sin_sig_root : sin_sig;
       const float fi = float(i);
 
       for (std::size_t j = 0; j < n; ++j) {
         S.tf[j] = reduce_angle(th[j]);
         S.pf[j] = reduce_angle(ph[j]);
+        S.len[j] = len[j];
+        S.gain[j] = gain[j];
       }
-      sincos_block(S.tf, S.sth, S.cth, n);
-      sincos_block(S.pf, S.sph, S.cph, n);
+      if (rest) {
+        for (std::size_t j = 0; j < n; ++j) {
+          S.d0x[j] = m_dir0x[row + j];
+          S.d0y[j] = m_dir0y[row + j];
+          S.d0z[j] = m_dir0z[row + j];
+        }
+      }
+      sincos_block(S.tf, S.sth, S.cth, n4);
+      sincos_block(S.pf, S.sph, S.cph, n4);
 
       // Forces, pseudo-force field (§3.2.2), top-of-head inertia, (4)' and (5)' increments.
-      for (std::size_t j = 0; j < n; ++j) {
-        const float d = len[j];
-        const float dx = S.sth[j] * S.sph[j], dy = S.cth[j], dz = S.sth[j] * S.cph[j];
-        S.dx[j] = dx;
-        S.dy[j] = dy;
-        S.dz[j] = dz;
-        float ax = bx, ay = by, az = bz;
+      const vf one = splat(1.0f), zero = splat(0.0f);
+      for (std::size_t j = 0; j < n4; j += kW) {
+        const vf d = ld(S.len + j);
+        const vf sth = ld(S.sth + j), cth = ld(S.cth + j), sph = ld(S.sph + j), cph = ld(S.cph + j);
+        const vf dx = sth * sph, dy = cth, dz = sth * cph;
+        st4(S.dx + j, dx);
+        st4(S.dy + j, dy);
+        st4(S.dz + j, dz);
+        const vf px = ld(S.px + j), py = ld(S.py + j), pz = ld(S.pz + j);
+        vf ax = splat(bx), ay = splat(by), az = splat(bz);
         if (rotating) {
           // -α × mid - ω × (ω × mid) at the segment midpoint
-          const float mx = S.px[j] + 0.5f * d * dx, my = S.py[j] + 0.5f * d * dy,
-                      mz = S.pz[j] + 0.5f * d * dz;
-          const float cx = wy * mz - wz * my, cy = wz * mx - wx * mz, cz = wx * my - wy * mx;
+          const vf mx = px + 0.5f * d * dx, my = py + 0.5f * d * dy, mz = pz + 0.5f * d * dz;
+          const vf cx = wy * mz - wz * my, cy = wz * mx - wx * mz, cz = wx * my - wy * mx;
           ax -= (ly * mz - lz * my) + (wy * cz - wz * cy);
           ay -= (lz * mx - lx * mz) + (wz * cx - wx * cz);
           az -= (lx * my - ly * mx) + (wx * cy - wy * cx);
         }
+        const vf nsf = ld(S.nsegf + j);
         if (pseudo) {
           // Near the head ((|q| - 1) < near_head) and against it ((D, F) < α |D| |F|) -> ε F.
-          const float ex = S.px[j] + d * dx - cf.x(), ey = S.py[j] + d * dy - cf.y(),
-                      ez = S.pz[j] + d * dz - cf.z();
-          const float qx = mq(0, 0) * ex + mq(0, 1) * ey + mq(0, 2) * ez;
-          const float qy = mq(1, 0) * ex + mq(1, 1) * ey + mq(1, 2) * ez;
-          const float qz = mq(2, 0) * ex + mq(2, 1) * ey + mq(2, 2) * ez;
-          const float q2 = qx * qx + qy * qy + qz * qz;
-          const float Dx = mg(0, 0) * qx + mg(0, 1) * qy + mg(0, 2) * qz;
-          const float Dy = mg(1, 0) * qx + mg(1, 1) * qy + mg(1, 2) * qz;
-          const float Dz = mg(2, 0) * qx + mg(2, 1) * qy + mg(2, 2) * qz;
-          const float da = Dx * ax + Dy * ay + Dz * az;
-          const float t = alpha2 * (Dx * Dx + Dy * Dy + Dz * Dz) * (ax * ax + ay * ay + az * az);
+          const vf ex = px + d * dx - cf.x(), ey = py + d * dy - cf.y(), ez = pz + d * dz - cf.z();
+          const vf qx = mq(0, 0) * ex + mq(0, 1) * ey + mq(0, 2) * ez;
+          const vf qy = mq(1, 0) * ex + mq(1, 1) * ey + mq(1, 2) * ez;
+          const vf qz = mq(2, 0) * ex + mq(2, 1) * ey + mq(2, 2) * ez;
+          const vf q2 = qx * qx + qy * qy + qz * qz;
+          const vf Dx = mg(0, 0) * qx + mg(0, 1) * qy + mg(0, 2) * qz;
+          const vf Dy = mg(1, 0) * qx + mg(1, 1) * qy + mg(1, 2) * qz;
+          const vf Dz = mg(2, 0) * qx + mg(2, 1) * qy + mg(2, 2) * qz;
+          const vf da = Dx * ax + Dy * ay + Dz * az;
+          const vf t = alpha2 * (Dx * Dx + Dy * Dy + Dz * Dz) * (ax * ax + ay * ay + az * az);
           // da < α |D||a| without square roots (sign cases of α and da).
-          const bool against = alpha < 0 ? ((da < 0) & (da * da > t)) : ((da < 0) | (da * da < t));
-          const bool applies = (fi <= ext * float(nseg[j]) + 1e-6f) & (q2 < near2) & against;
-          const float f = applies ? epsf : 1.0f;
+          const vi against = alpha < 0 ? ((da < 0) & (da * da > t)) : ((da < 0) | (da * da < t));
+          const vi applies = (fi <= ext * nsf + 1e-6f) & (q2 < near2) & against;
+          const vf f = applies ? splat(epsf) : one;
           ax *= f;
           ay *= f;
           az *= f;
         }
-        float G = gain[j];
+        vf G = ld(S.gain + j);
         if (top) {
-          const float ey = (mq(1, 0) * (S.px[j] - cf.x()) + mq(1, 1) * (S.py[j] - cf.y()) +
-                            mq(1, 2) * (S.pz[j] - cf.z()));
+          const vf ey =
+              mq(1, 0) * (px - cf.x()) + mq(1, 1) * (py - cf.y()) + mq(1, 2) * (pz - cf.z());
           G = ey > top_h ? G * top_scale : G;
         }
         if (rest) {
-          const float r = G > 0 ? rest_k / G : 0.0f;
-          ax += r * (m_dir0x[row + j] - dx);
-          ay += r * (m_dir0y[row + j] - dy);
-          az += r * (m_dir0z[row + j] - dz);
+          const vf r = G > 0 ? rest_k / (G > 0 ? G : one) : zero;
+          ax += r * (ld(S.d0x + j) - dx);
+          ay += r * (ld(S.d0y + j) - dy);
+          az += r * (ld(S.d0z + j) - dz);
         }
-        S.ax[j] = ax;
-        S.ay[j] = ay;
-        S.az[j] = az;
-        S.g[j] = G;
-        const float sth = S.sth[j], cth = S.cth[j], sph = S.sph[j], cph = S.cph[j];
-        const float Fth = ax * cth * sph - ay * sth + az * cth * cph;  // (F, V_θ)
-        const float sgn = sth >= 0 ? 1.0f : -1.0f;
-        const float Fph = sgn * (ax * cph - az * sph);  // (F, V_φ)
+        st4(S.ax + j, ax);
+        st4(S.ay + j, ay);
+        st4(S.az + j, az);
+        st4(S.g + j, G);
+        const vf Fth = ax * cth * sph - ay * sth + az * cth * cph;  // (F, V_θ)
+        const vf Fph0 = ax * cph - az * sph;                        // (F, V_φ) up to sign θ
+        const vf abs_sth = sth < 0 ? -sth : sth;
+        const vf Fph = sth >= 0 ? Fph0 : -Fph0;
         // (4)' and (5)': u_i = |s_i|/2, v_i = |s_i| |sin θ| / 2 -> v_i / u_i = |sin θ|.
-        S.inc_t[j] = dt2f * G * Fth;
-        S.inc_p[j] = dt2f * G * std::abs(sth) * Fph;
-        S.flag[j] = (std::abs(sth) < pole) & (fi <= float(nseg[j]));
+        st4(S.inc_t + j, dt2f * G * Fth);
+        st4(S.inc_p + j, dt2f * G * abs_sth * Fph);
+        const vi fl = (abs_sth < pole) & (fi <= nsf);
+        std::memcpy(S.flag + j, &fl, sizeof fl);
       }
-      // Segment nearly parallel to y: the θ plane is spanned by y and F (Fig. 8), so the segment
-      // turns towards the horizontal part of F with θ'' = c u F_θ. Near the pole this is the
-      // small-angle form of (4)' for the horizontal offset h = (x, z) of the direction, written
-      // as a vector so the state does not jump when the plane follows F. (Rare: per strand, in
-      // double precision, before the general update overwrites θ^{n-1}.)
+      std::size_t m = 0;
       for (std::size_t j = 0; j < n; ++j) {
-        if (!S.flag[j]) continue;
-        __atomic_fetch_add(&g_pole, 1, __ATOMIC_RELAXED);
-        double t = th[j], p = ph[j];
-        const Vec3 dir = segment_direction(t, p);
-        const Vec3 dirp = segment_direction(thn[j], phn[j]);  // still θ^{n-1}, φ^{n-1}
-        const Vec2 h(dir.x(), dir.z()), hp(dirp.x(), dirp.z());
-        const Vec2 ah(S.ax[j], S.az[j]);
-        Vec2 hn = h + damp * (h - hp) + dt2 * double(S.g[j]) * ah;
-        if (hn.norm() > 1.0) hn.normalize();
-        const double yv =
-            (dir.y() >= 0 ? 1.0 : -1.0) * std::sqrt(std::max(0.0, 1.0 - hn.squaredNorm()));
-        double tn, pn;
-        direction_angles(Vec3(hn.x(), yv, hn.y()), p, tn, pn);
-        direction_angles(dir, pn, t, p);  // the current angles on the same branch
-        thn[j] = tn;
-        phn[j] = pn;
-        TH[row + j] = t;
-        PH[row + j] = p;
+        S.list[m] = int(j);
+        m += std::size_t(S.flag[j] != 0);
+      }
+      for (std::size_t q = 0; q < m; ++q) {
+        S.tf[q] = reduce_angle(thn[S.list[q]]);  // still θ^{n-1}, φ^{n-1}
+        S.pf[q] = reduce_angle(phn[S.list[q]]);
+      }
+      sincos_block(S.tf, S.psth, S.pcth, m);
+      sincos_block(S.pf, S.psph, S.pcph, m);
+      // Gathered into contiguous lanes, then two strands at a time in double precision.
+      for (std::size_t q = 0; q < m; ++q) {
+        const std::size_t j = std::size_t(S.list[q]);
+        S.c[0][q] = S.dx[j];
+        S.c[1][q] = S.dy[j];
+        S.c[2][q] = S.dz[j];
+        S.c[3][q] = double(S.psth[q]) * S.psph[q];
+        S.c[4][q] = double(S.psth[q]) * S.pcph[q];
+        S.c[5][q] = dt2 * double(S.g[j]) * S.ax[j];
+        S.c[6][q] = dt2 * double(S.g[j]) * S.az[j];
+        S.c[7][q] = ph[j];
+      }
+      for (std::size_t q = m; q < (m + kWd - 1) / kWd * kWd; ++q)
+        for (auto& c : S.c) c[q] = 0.0;
+      for (std::size_t q = 0; q < m; q += kWd) {
+        const vd hx = ldd(S.c[0] + q), dy = ldd(S.c[1] + q), hz = ldd(S.c[2] + q);
+        vd nx = hx + damp * (hx - ldd(S.c[3] + q)) + ldd(S.c[5] + q);
+        vd nz = hz + damp * (hz - ldd(S.c[4] + q)) + ldd(S.c[6] + q);
+        const vd h2 = nx * nx + nz * nz;
+        const vd r = h2 > 1.0 ? 1.0 / sqrt_v(h2 > 1.0 ? h2 : splatd(1.0)) : splatd(1.0);
+        nx *= r;
+        nz *= r;
+        const vd y2 = 1.0 - nx * nx - nz * nz;
+        const vd yv = sqrt_v(y2 > 0.0 ? y2 : splatd(0.0));
+        vd tn, pn, t, p;
+        direction_angles_v(nx, dy >= 0.0 ? yv : -yv, nz, ldd(S.c[7] + q), tn, pn);
+        direction_angles_v(hx, dy, hz, pn, t, p);  // the current angles on the same branch
+        std::memcpy(S.c[0] + q, &tn, sizeof tn);
+        std::memcpy(S.c[1] + q, &pn, sizeof pn);
+        std::memcpy(S.c[2] + q, &t, sizeof t);
+        std::memcpy(S.c[3] + q, &p, sizeof p);
       }
       for (std::size_t j = 0; j < n; ++j) {
         const double t0 = th[j], p0 = ph[j];
-        const double tn = t0 + damp * (t0 - thn[j]) + double(S.inc_t[j]);
-        const double pn = p0 + damp * (p0 - phn[j]) + double(S.inc_p[j]);
-        thn[j] = S.flag[j] ? thn[j] : tn;
-        phn[j] = S.flag[j] ? phn[j] : pn;
+        thn[j] = t0 + damp * (t0 - thn[j]) + double(S.inc_t[j]);
+        phn[j] = p0 + damp * (p0 - phn[j]) + double(S.inc_p[j]);
+      }
+      for (std::size_t q = 0; q < m; ++q) {
+        const std::size_t j = std::size_t(S.list[q]);
+        thn[j] = S.c[0][q];
+        phn[j] = S.c[1][q];
+        TH[row + j] = S.c[2][q];
+        PH[row + j] = S.c[3][q];
       }
       if (fluct) {
         for (std::size_t j = 0; j < n; ++j) {
@@ -359,12 +533,59 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
           phn[j] += m_p.fluctuation * rng.uniform(-1.0, 1.0);
         }
       }
-      for (std::size_t j = 0; j < n; ++j) {
-        S.tf[j] = reduce_angle(thn[j]);
-        S.pf[j] = reduce_angle(phn[j]);
+      if (fluct) {
+        for (std::size_t j = 0; j < n; ++j) {
+          S.tf[j] = reduce_angle(thn[j]);
+          S.pf[j] = reduce_angle(phn[j]);
+        }
+        sincos_block(S.tf, S.sth, S.cth, n);
+        sincos_block(S.pf, S.sph, S.cph, n);
+      } else {
+        // sin/cos of the new angles from the old ones by the addition theorems with short Taylor
+        // series of the (small) change; changes above 0.1 rad and the pole lanes (re-branched
+        // angles) are recomputed directly.
+        for (std::size_t j = 0; j < n; ++j) {
+          S.tf[j] = float(thn[j] - th[j]);
+          S.pf[j] = float(phn[j] - ph[j]);
+        }
+        for (std::size_t j = 0; j < n4; j += kW) {
+          const vf a = ld(S.tf + j), b = ld(S.pf + j);
+          const vf za = a * a, zb = b * b;
+          const vf sa = a * (1.0f - za * (1.0f / 6.0f) * (1.0f - za * 0.05f));
+          const vf ca = 1.0f - za * 0.5f * (1.0f - za * (1.0f / 12.0f));
+          const vf sb = b * (1.0f - zb * (1.0f / 6.0f) * (1.0f - zb * 0.05f));
+          const vf cb = 1.0f - zb * 0.5f * (1.0f - zb * (1.0f / 12.0f));
+          const vf s_t = ld(S.sth + j), c_t = ld(S.cth + j);
+          const vf s_p = ld(S.sph + j), c_p = ld(S.cph + j);
+          st4(S.sth + j, s_t * ca + c_t * sa);
+          st4(S.cth + j, c_t * ca - s_t * sa);
+          st4(S.sph + j, s_p * cb + c_p * sb);
+          st4(S.cph + j, c_p * cb - s_p * sb);
+          const vi big = ((a > 0.1f) | (a < -0.1f) | (b > 0.1f) | (b < -0.1f));
+          vi fl;
+          std::memcpy(&fl, S.flag + j, sizeof fl);
+          fl = fl | big;
+          std::memcpy(S.flag + j, &fl, sizeof fl);
+        }
+        std::size_t mb = 0;
+        for (std::size_t j = 0; j < n; ++j) {
+          S.list[mb] = int(j);
+          mb += std::size_t(S.flag[j] != 0);
+        }
+        for (std::size_t q = 0; q < mb; ++q) {
+          S.tf[q] = reduce_angle(thn[S.list[q]]);
+          S.pf[q] = reduce_angle(phn[S.list[q]]);
+        }
+        sincos_block(S.tf, S.psth, S.pcth, mb);
+        sincos_block(S.pf, S.psph, S.pcph, mb);
+        for (std::size_t q = 0; q < mb; ++q) {
+          const std::size_t j = std::size_t(S.list[q]);
+          S.sth[j] = S.psth[q];
+          S.cth[j] = S.pcth[q];
+          S.sph[j] = S.psph[q];
+          S.cph[j] = S.pcph[q];
+        }
       }
-      sincos_block(S.tf, S.sth, S.cth, n);
-      sincos_block(S.pf, S.sph, S.cph, n);
       for (std::size_t j = 0; j < n; ++j) {
         S.nx[j] = S.sth[j] * S.sph[j];
         S.ny[j] = S.cth[j];
@@ -373,28 +594,59 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
       // §3.2.3 joint angle ϑ at p_{i-1} (the bend between s_{i-1} and s_i) limited to σ: flagged
       // in single precision with a small margin, clamped exactly in double per strand.
       if (i >= 2 && cs > -1.0) {
-        const float csf = float(cs) + 1e-5f;
-        for (std::size_t j = 0; j < n; ++j)
-          S.flag[j] = S.pdx[j] * S.nx[j] + S.pdy[j] * S.ny[j] + S.pdz[j] * S.nz[j] < csf;
+        // Clamped to σ minus 2e-5 rad so that single-precision rounding never exceeds σ.
+        const double csm = std::cos(std::acos(cs) - 2e-5), ssm = std::sqrt(1.0 - csm * csm);
+        const float csf = float(csm);
+        std::size_t mc = 0;
         for (std::size_t j = 0; j < n; ++j) {
-          if (!S.flag[j] || int(i) > nseg[j]) continue;
-          const std::size_t prow = row - N;  // s_{i-1}, already advanced (in THN/PHN)
-          const Vec3 pd = segment_direction(THN[prow + j], PHN[prow + j]);
-          Vec3 nd = segment_direction(thn[j], phn[j]);
-          const double c = pd.dot(nd);
-          if (!(c < cs)) continue;
-          __atomic_fetch_add(&g_clamp, 1, __ATOMIC_RELAXED);
-          Vec3 perp = nd - c * pd;
-          const double pn = perp.norm();
-          perp = pn > 1e-12 ? Vec3(perp / pn) : Vec3(pd.unitOrthogonal());
-          nd = cs * pd + ss * perp;
-          double tn = thn[j], pnn = phn[j];
-          direction_angles(nd, pnn, tn, pnn);
-          thn[j] = tn;
-          phn[j] = pnn;
-          S.nx[j] = float(nd.x());
-          S.ny[j] = float(nd.y());
-          S.nz[j] = float(nd.z());
+          const float c = S.pdx[j] * S.nx[j] + S.pdy[j] * S.ny[j] + S.pdz[j] * S.nz[j];
+          S.list[mc] = int(j);
+          mc += std::size_t((c < csf) & (fi <= float(nseg[j])));
+        }
+        for (std::size_t q = 0; q < mc; ++q) {
+          const std::size_t j = std::size_t(S.list[q]);
+          S.c[0][q] = S.pdx[j];
+          S.c[1][q] = S.pdy[j];
+          S.c[2][q] = S.pdz[j];
+          S.c[3][q] = S.nx[j];
+          S.c[4][q] = S.ny[j];
+          S.c[5][q] = S.nz[j];
+          S.c[6][q] = phn[j];
+        }
+        for (std::size_t q = mc; q < (mc + kWd - 1) / kWd * kWd; ++q)
+          for (auto& c : S.c) c[q] = 0.0;
+        for (std::size_t q = 0; q < mc; q += kWd) {
+          const vd px = ldd(S.c[0] + q), py = ldd(S.c[1] + q), pz = ldd(S.c[2] + q);
+          const vd nx = ldd(S.c[3] + q), ny = ldd(S.c[4] + q), nz = ldd(S.c[5] + q);
+          const vd c = px * nx + py * ny + pz * nz;
+          vd ex = nx - c * px, ey = ny - c * py, ez = nz - c * pz;
+          const vd en = sqrt_v(ex * ex + ey * ey + ez * ez);
+          // Antiparallel (no plane): any direction perpendicular to pd.
+          const auto deg = en <= 1e-6;
+          const vd ox = abs_v(px) < 0.9 ? splatd(0.0) : -pz,
+                   oy = abs_v(px) < 0.9 ? -pz : splatd(0.0),
+                   oz = abs_v(px) < 0.9 ? py : px;  // pd × (x or y axis)
+          ex = deg ? ox : ex;
+          ey = deg ? oy : ey;
+          ez = deg ? oz : ez;
+          const vd inv = 1.0 / sqrt_v(ex * ex + ey * ey + ez * ez);
+          const vd dx = csm * px + ssm * ex * inv, dy = csm * py + ssm * ey * inv,
+                   dz = csm * pz + ssm * ez * inv;
+          vd tn, pn;
+          direction_angles_v(dx, dy, dz, ldd(S.c[6] + q), tn, pn);
+          std::memcpy(S.c[0] + q, &tn, sizeof tn);
+          std::memcpy(S.c[1] + q, &pn, sizeof pn);
+          std::memcpy(S.c[3] + q, &dx, sizeof dx);
+          std::memcpy(S.c[4] + q, &dy, sizeof dy);
+          std::memcpy(S.c[5] + q, &dz, sizeof dz);
+        }
+        for (std::size_t q = 0; q < mc; ++q) {
+          const std::size_t j = std::size_t(S.list[q]);
+          thn[j] = S.c[0][q];
+          phn[j] = S.c[1][q];
+          S.nx[j] = float(S.c[3][q]);
+          S.ny[j] = float(S.c[4][q]);
+          S.nz[j] = float(S.c[5][q]);
         }
       }
       if (m_p.ellipsoid_constraint) {

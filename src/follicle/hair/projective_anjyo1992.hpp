@@ -145,7 +145,7 @@ class ProjectiveSolver {
   std::vector<double> m_theta0, m_phi0;  // [K*N] styled angles
   std::vector<Vec3> m_root;              // [N] roots, head frame
   // Single-precision copies for the vectorised step (structure of arrays, [segment][strand]).
-  std::vector<float> m_lenf, m_gainf;          // [K*N]
+  std::vector<float> m_lenf, m_gainf;            // [K*N]
   std::vector<float> m_dir0x, m_dir0y, m_dir0z;  // [K*N] styled directions (rest_spring only)
   std::vector<float> m_rootx, m_rooty, m_rootz;  // [N]
 };

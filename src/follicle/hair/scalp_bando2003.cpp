@@ -6,26 +6,10 @@
 #include <numeric>
 
 #include "follicle/core/error.hpp"
+#include "follicle/geom/curves.hpp"
 #include "follicle/geom/harmonic_map.hpp"
 
 namespace follicle::hair {
-
-Vec3 catmull_rom_eval(const std::vector<Vec3>& pts, double t) {
-  const int n = int(pts.size());
-  if (n == 1) return pts[0];
-  const double x = std::clamp(t, 0.0, 1.0) * (n - 1);
-  const int i = std::min(int(std::floor(x)), n - 2);
-  const double u = x - i;
-  auto P = [&](int k) -> Vec3 {
-    if (k < 0) return 2 * pts[0] - pts[1];
-    if (k >= n) return 2 * pts[n - 1] - pts[n - 2];
-    return pts[k];
-  };
-  const Vec3 p0 = P(i - 1), p1 = P(i), p2 = P(i + 1), p3 = P(i + 2);
-  const double u2 = u * u, u3 = u2 * u;
-  return 0.5 * ((2 * p1) + (-p0 + p2) * u + (2 * p0 - 5 * p1 + 4 * p2 - p3) * u2 +
-                (-p0 + 3 * p1 - 3 * p2 + p3) * u3);
-}
 
 namespace {
 
@@ -67,12 +51,15 @@ Scalp Scalp::trim(const geom::TriMesh& head, const ScalpCurves& curves, const Sc
   const int M = p.curve_samples;
   std::vector<Vec3> loop;
   std::vector<std::pair<int, double>> loop_param;
-  for (int k = 0; k < 4; ++k)
+  for (int k = 0; k < 4; ++k) {
+    // Uniform open Catmull-Rom through the control points (phantom ends by reflection).
+    const geom::CatmullRom3 cr(curves[k], 0.0, false);
     for (int i = 0; i < M; ++i) {
       const double t = double(i) / M;
-      loop.push_back(catmull_rom_eval(curves[k], t));
+      loop.push_back(cr.eval(t * double(cr.num_segments())));
       loop_param.emplace_back(k, t);
     }
+  }
   // 2. Plane of the loop (Newell normal), oriented away from the head's centre.
   Vec3 c = Vec3::Zero(), nrm = Vec3::Zero();
   for (std::size_t i = 0; i < loop.size(); ++i) {

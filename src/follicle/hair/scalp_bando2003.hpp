@@ -18,7 +18,7 @@
 namespace follicle::hair {
 
 struct ScalpParams {
-  double root_depth = 0.003;  // s_r [m], depth of the hair root beneath the scalp
+  double root_depth = 0.012;  // s_r [m], depth of the hair root (>= the particle spacing)
   double max_length = 0.25;   // [m] hair length where the length map is white
   int curve_samples = 64;     // samples per Catmull-Rom curve for trimming
   template <class V>
@@ -77,9 +77,5 @@ class Scalp {
   int m_grid = 1;
   std::vector<std::vector<uint32_t>> m_cells;  // uv grid -> faces overlapping the cell
 };
-
-/// Catmull-Rom spline through `pts` (end tangents by reflection) at t in [0, 1] over the whole
-/// polygon. Hand-written here (a few lines) until geom/curves.hpp is available.
-Vec3 catmull_rom_eval(const std::vector<Vec3>& pts, double t);
 
 }  // namespace follicle::hair

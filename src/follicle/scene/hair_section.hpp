@@ -67,8 +67,7 @@ struct HairRenderParams {
   template <class V>
   void visit(V&& v) {
     v("width_px", width_px,
-      ParamInfo{"line width in output pixels (narrower lines fade by coverage)", "px", 0.01,
-                64.0});
+      ParamInfo{"line width in output pixels (narrower lines fade by coverage)", "px", 0.01, 64.0});
     v("opacity", opacity, ParamInfo{"hair opacity", "", 0.0, 1.0});
   }
 };

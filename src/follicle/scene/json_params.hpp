@@ -123,7 +123,7 @@ concept HasRequired = requires {
 // writes itself and names its type for the docs. `DocObject` (a visitable struct) documents the
 // object form's keys.
 template <class T>
-concept CustomJson = requires(T & t, const T& ct, const Json& j, const std::string& p,
+concept CustomJson = requires(T& t, const T& ct, const Json& j, const std::string& p,
                               const JsonSource& s) {
   t.read_json_custom(j, p, s);
   { ct.to_json_custom() } -> std::same_as<Json>;

@@ -81,8 +81,9 @@ void Scene::validate(const JsonSource& src) const {
       if (m.axis.norm() < 1e-9) json_fail(src, "animation.head_motion.axis", "axis is zero");
     }
     if (m.interp != "step" && m.interp != "linear" && m.interp != "smooth")
-      json_fail(src, "animation.head_motion.interp",
-                "unknown value \"" + m.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
+      json_fail(
+          src, "animation.head_motion.interp",
+          "unknown value \"" + m.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
     if (m.kind == HeadMotionKind::Keyframes && m.keys.empty())
       json_fail(src, "animation.head_motion.keys", "kind \"keyframes\" needs at least one key");
     for (std::size_t k = 1; k < m.keys.size(); ++k)

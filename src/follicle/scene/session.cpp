@@ -202,10 +202,10 @@ std::string Session::summary() const {
   out += fmt::format("render: {}x{} px, supersample {}\n", m_scene.render.width,
                      m_scene.render.height, m_scene.render.supersample);
   for (const auto& h : m_scene.hair)
-    out += fmt::format("hair: {} on mesh \"{}\", style {}, density scale {}\n", h.name, h.mesh,
-                       h.style.custom ? "\"" + h.style.custom->name + "\" (custom)"
-                                      : "\"" + h.style.preset + "\"",
-                       h.density_scale);
+    out += fmt::format(
+        "hair: {} on mesh \"{}\", style {}, density scale {}\n", h.name, h.mesh,
+        h.style.custom ? "\"" + h.style.custom->name + "\" (custom)" : "\"" + h.style.preset + "\"",
+        h.density_scale);
   if (m_scene.animation)
     out += fmt::format("animation: {} frames at {} fps\n", m_scene.animation->frame_count(),
                        m_scene.animation->fps);

@@ -16,7 +16,6 @@
 
 namespace follicle::scene {
 
-
 namespace {
 
 std::filesystem::path group_cache_dir(const std::filesystem::path& dir, std::size_t g) {
@@ -111,7 +110,8 @@ std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int
     geom::TriMesh world = *mesh(mi);
     world.transform(m_scene.assets.meshes[mi].transform.matrix());
     try {
-      gg.hull = hs.hull ? hs.hull->ellipsoid() : sim::fit_head_ellipsoid(world.positions, hs.hull_fit);
+      gg.hull =
+          hs.hull ? hs.hull->ellipsoid() : sim::fit_head_ellipsoid(world.positions, hs.hull_fit);
       const geom::MeshQuery query(world);
       const auto scalp = hair::mesh_query_closest_point(query);
       const hair::HairStyle style = hs.style.resolve(hs.density_scale);
@@ -152,7 +152,8 @@ std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int
     const auto key_file = rt.cache_dir / "cache_key.json";
     std::error_code ec;
     std::filesystem::create_directories(rt.cache_dir, ec);
-    if (ec) fail_at(rt.cache_dir.string(), "cannot create the strand cache folder: {}", ec.message());
+    if (ec)
+      fail_at(rt.cache_dir.string(), "cannot create the strand cache folder: {}", ec.message());
     const bool same = std::filesystem::is_regular_file(key_file) && read_file(key_file) == key;
     if (!same) {  // stale frames from other settings: remove our own files only
       for (std::size_t i = 0; i < m_scene.hair.size(); ++i) {

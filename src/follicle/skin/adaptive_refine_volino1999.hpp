@@ -25,7 +25,8 @@ struct RefineParams {
   bool smooth = true;  // new vertices on the curved (PN-triangle) edge, not the flat midpoint
   template <class V>
   void visit(V&& v) {
-    v("smooth", smooth, ParamInfo{"place new vertices on the smooth surface through the normals", ""});
+    v("smooth", smooth,
+      ParamInfo{"place new vertices on the smooth surface through the normals", ""});
     v("max_levels", max_levels, ParamInfo{"refinement passes", "", 0, 8});
     v("edge_factor", edge_factor, ParamInfo{"target edge length / wrinkle width", "", 0.05, 10.0});
     v("region_widths", region_widths,

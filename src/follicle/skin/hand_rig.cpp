@@ -109,8 +109,7 @@ std::unique_ptr<HandRig> HandRig::load(const Context& ctx,
                                        const HandRigParams& params) {
   const auto base = anim::load_makehuman_obj(makehuman_dir / "base.obj");
   anim::Skeleton skel = anim::load_mhskel(makehuman_dir / "default.mhskel", base.positions);
-  const auto w =
-      anim::load_mhw(makehuman_dir / "default_weights.mhw", skel, base.positions.size());
+  const auto w = anim::load_mhw(makehuman_dir / "default_weights.mhw", skel, base.positions.size());
   return std::make_unique<HandRig>(ctx, base, std::move(skel), w, params);
 }
 
@@ -118,9 +117,9 @@ HandRig::HandRig(const Context& ctx, const anim::MakeHumanBase& base, anim::Skel
                  const anim::SkinWeights& weights, const HandRigParams& params)
     : m_params(params), m_skel(std::move(skel)) {
   m_params.validate();
-  m_hand = anim::extract_hand(base, m_skel, weights,
-                              params.left ? anim::Side::left : anim::Side::right,
-                              params.weight_threshold);
+  m_hand =
+      anim::extract_hand(base, m_skel, weights, params.left ? anim::Side::left : anim::Side::right,
+                         params.weight_threshold);
   if (params.joint_wrinkles) build_joint_wrinkles();
   // Adaptive refinement around the joint furrows (paper §8: 4,000 -> 34,000 triangles).
   m_refined = refine_around_wrinkles(m_hand.mesh, m_wrinkles, params.refine);
@@ -128,6 +127,12 @@ HandRig::HandRig(const Context& ctx, const anim::MakeHumanBase& base, anim::Skel
   m_rest.name = m_hand.mesh.name;
   m_weights = propagate_weights(m_hand.weights, m_refined);
   m_layer = std::make_unique<WrinkleLayer>(m_rest, m_wrinkles, 10.0, ShrinkageMethod::deformation);
+  {
+    std::vector<Vec3> face_n;
+    std::vector<double> face_area;
+    compute_vertex_normals(ctx, m_rest, m_layer->texture_mesh(), m_rest.positions, face_n,
+                           face_area, m_rest_normals);
+  }
   m_fine = generate_fine_wrinkles(ctx, m_rest, fine_keys(), params.fine);
   m_fine_anim = std::make_unique<FineWrinkleAnimator>(m_rest, m_fine);
   m_track = anim::finger_flexion_track(2.0);
@@ -151,9 +156,9 @@ void HandRig::build_joint_wrinkles() {
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     const Vec3i& F = m.faces[f];
     const Vec3i& T = m.uv_faces[f];
-    a3 += 0.5 * (m.positions[F[1]] - m.positions[F[0]])
-                    .cross(m.positions[F[2]] - m.positions[F[0]])
-                    .norm();
+    a3 +=
+        0.5 *
+        (m.positions[F[1]] - m.positions[F[0]]).cross(m.positions[F[2]] - m.positions[F[0]]).norm();
     const Vec2 e1 = m.uvs[T[1]] - m.uvs[T[0]], e2 = m.uvs[T[2]] - m.uvs[T[0]];
     at += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
   }
@@ -170,43 +175,43 @@ void HandRig::build_joint_wrinkles() {
       palm -= y * y.dot(palm);
       if (palm.norm() < 1e-12) continue;
       for (int palmar = 0; palmar < (m_params.palmar_creases ? 2 : 1); ++palmar) {
-      const Vec3 dorsal = palmar ? Vec3(palm.normalized()) : Vec3(-palm.normalized());
-      const Vec3 side = y.cross(dorsal);
-      for (int k = 0; k < n; ++k) {
-        const Vec3 o = bone.head + (k - 0.5 * (n - 1)) * m_params.crease_spacing * y;
-        // Four hits across the back of the joint, at t = 0, 1/3, 2/3, 1 of the Bezier curve;
-        // the arc shrinks if the hits straddle a UV seam.
-        double arc = m_params.crease_half_arc;
-        for (int attempt = 0; attempt < 5; ++attempt, arc *= 0.75) {
-          std::array<Hit, 4> h;
-          bool ok = true;
-          for (int i = 0; i < 4 && ok; ++i) {
-            const double phi = arc * (-1.0 + 2.0 * i / 3.0);
-            const Vec3 d = std::cos(phi) * dorsal + std::sin(phi) * side;
-            ok = first_hit(m, o, d, h[i]);
+        const Vec3 dorsal = palmar ? Vec3(palm.normalized()) : Vec3(-palm.normalized());
+        const Vec3 side = y.cross(dorsal);
+        for (int k = 0; k < n; ++k) {
+          const Vec3 o = bone.head + (k - 0.5 * (n - 1)) * m_params.crease_spacing * y;
+          // Four hits across the back of the joint, at t = 0, 1/3, 2/3, 1 of the Bezier curve;
+          // the arc shrinks if the hits straddle a UV seam.
+          double arc = m_params.crease_half_arc;
+          for (int attempt = 0; attempt < 5; ++attempt, arc *= 0.75) {
+            std::array<Hit, 4> h;
+            bool ok = true;
+            for (int i = 0; i < 4 && ok; ++i) {
+              const double phi = arc * (-1.0 + 2.0 * i / 3.0);
+              const Vec3 d = std::cos(phi) * dorsal + std::sin(phi) * side;
+              ok = first_hit(m, o, d, h[i]);
+            }
+            for (int i = 0; i < 3 && ok; ++i) {
+              const double d3 = (h[i + 1].x - h[i].x).norm();
+              const double duv = (h[i + 1].uv - h[i].uv).norm() * scale;
+              if (duv > 3.0 * d3 + 1e-4) ok = false;  // a UV seam between the hits
+            }
+            if (!ok) continue;
+            // Interpolating Bezier: B(0) = s0, B(1/3) = s1, B(2/3) = s2, B(1) = s3.
+            const Vec2 p0 = h[0].uv, p3 = h[3].uv;
+            const Vec2 A = 27.0 * h[1].uv - 8.0 * p0 - p3;
+            const Vec2 B = 27.0 * h[2].uv - p0 - 8.0 * p3;
+            LargeWrinkle w;
+            w.name = fmt::format("{}{}#{}", name, palmar ? "/palm" : "", k);
+            w.control = {p0, (2.0 * A - B) / 18.0, (2.0 * B - A) / 18.0, p3};
+            w.depth = m_params.joint_depth;
+            w.width = m_params.joint_width;
+            w.r = m_params.joint_r;
+            w.end_taper = m_params.joint_end_taper;
+            m_wrinkles.push_back(w);
+            m_info.push_back({name, k, palmar != 0});
+            break;
           }
-          for (int i = 0; i < 3 && ok; ++i) {
-            const double d3 = (h[i + 1].x - h[i].x).norm();
-            const double duv = (h[i + 1].uv - h[i].uv).norm() * scale;
-            if (duv > 3.0 * d3 + 1e-4) ok = false;  // a UV seam between the hits
-          }
-          if (!ok) continue;
-          // Interpolating Bezier: B(0) = s0, B(1/3) = s1, B(2/3) = s2, B(1) = s3.
-          const Vec2 p0 = h[0].uv, p3 = h[3].uv;
-          const Vec2 A = 27.0 * h[1].uv - 8.0 * p0 - p3;
-          const Vec2 B = 27.0 * h[2].uv - p0 - 8.0 * p3;
-          LargeWrinkle w;
-          w.name = fmt::format("{}{}#{}", name, palmar ? "/palm" : "", k);
-          w.control = {p0, (2.0 * A - B) / 18.0, (2.0 * B - A) / 18.0, p3};
-          w.depth = m_params.joint_depth;
-          w.width = m_params.joint_width;
-          w.r = m_params.joint_r;
-          w.end_taper = m_params.joint_end_taper;
-          m_wrinkles.push_back(w);
-          m_info.push_back({name, k, palmar != 0});
-          break;
         }
-      }
       }
     }
 }
@@ -222,7 +227,8 @@ std::array<std::vector<DirectionKey>, 2> HandRig::fine_keys() const {
   std::vector<int> face_of_uv(m.uvs.size(), -1), pos_of_uv(m.uvs.size(), -1);
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     const Vec3i& F = m.faces[f];
-    const Vec3 nf = (m.positions[F[1]] - m.positions[F[0]]).cross(m.positions[F[2]] - m.positions[F[0]]);
+    const Vec3 nf =
+        (m.positions[F[1]] - m.positions[F[0]]).cross(m.positions[F[2]] - m.positions[F[0]]);
     for (int c = 0; c < 3; ++c) {
       normals[F[c]] += nf;
       const int t = m.uv_faces[f][c];
@@ -281,12 +287,26 @@ std::array<std::vector<DirectionKey>, 2> HandRig::fine_keys() const {
 void HandRig::update(const Context& ctx, double flexion, HandState& s,
                      const HandUpdateOptions& opt) const {
   s.flexion = flexion;
-  anim::skin_lbs(ctx, m_rest.positions, m_weights, anim::skinning_transforms(m_skel, pose(flexion)),
-                 s.animated);
+  const anim::SkinningTransforms xf = anim::skinning_transforms(m_skel, pose(flexion));
+  anim::skin_lbs(ctx, m_rest.positions, m_weights, xf, s.animated);
   const TextureSpaceMesh& tex = m_layer->texture_mesh();
   const std::size_t nv = s.animated.size();
   if (opt.joint_wrinkles && !m_wrinkles.empty()) {
-    compute_vertex_normals(ctx, m_rest, tex, s.animated, s.face_n, s.face_area, s.normals);
+    // Normals of the skinned surface by blending the rest normals with the bones' rotations
+    // (n' ~ sum w_i R_i n): the wrinkle displacement only needs a smooth normal field, and this
+    // saves one full face-normal pass per frame.
+    s.normals.resize(nv);
+    parallel_for(
+        ctx, 0, nv,
+        [&](std::size_t v) {
+          const Vec3& n = m_rest_normals[v];
+          Vec3 b = Vec3::Zero();
+          for (uint32_t k = m_weights.offsets[v]; k < m_weights.offsets[v + 1]; ++k)
+            b += double(m_weights.weight[k]) * (n + xf.A[m_weights.bone[k]] * n);
+          const double l = b.norm();
+          s.normals[v] = l > 0 ? Vec3(b / l) : n;
+        },
+        2048);
     m_layer->heights(ctx, s.animated, s.joint_height);  // (2.3)(2.4)(2.1) M(s) S(l)
     s.positions.resize(nv);
     parallel_for(
@@ -299,7 +319,7 @@ void HandRig::update(const Context& ctx, double flexion, HandState& s,
   }
   compute_vertex_normals(ctx, m_rest, tex, s.positions, s.face_n, s.face_area, s.normals);
   if (opt.fine_shrinkage || opt.fine_relief) {
-    m_fine_anim->shrinkage(ctx, s.animated, s.fine_shrinkage);  // (2.3) per field
+    m_fine_anim->shrinkage(ctx, s.animated, s.fine_shrinkage);                    // (2.3) per field
     if (opt.fine_relief) m_fine_anim->modulate(ctx, s.fine_shrinkage, s.relief);  // (2.4)
   }
 }
@@ -322,6 +342,7 @@ HandFrame HandRig::frame_at_flexion(const Context& ctx, double flexion, bool wri
   update(ctx, flexion, s, opt);
   HandFrame out;
   out.flexion = flexion;
+  out.bump_strength = m_params.bump_strength;
   out.mesh = std::make_shared<const geom::TriMesh>(deformed_mesh(s));
   if (wrinkles) {
     auto h = std::make_shared<image::ImageF>(std::move(s.relief));

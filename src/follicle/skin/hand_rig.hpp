@@ -6,10 +6,10 @@
 // fields over the whole hand) modulated per frame by the shrinkage perpendicular to each field
 // (2.3, 2.4) and bump-mapped.
 //
-// Per frame (update): skin_lbs -> normals -> WrinkleLayer::heights (shrinkage + M(s) S(l)) ->
-// displaced surface + normals -> FineWrinkleAnimator::shrinkage (per uv vertex) -> optionally
-// the modulated relief map (per texel). Everything is parallel and deterministic for any thread
-// count.
+// Per frame (update): skin_lbs -> skinned rest normals -> WrinkleLayer::heights (shrinkage +
+// M(s) S(l)) -> displaced surface + its normals -> FineWrinkleAnimator::shrinkage (per uv vertex,
+// on the skinned surface) -> optionally the modulated relief map (per texel). Everything is
+// parallel and deterministic for any thread count.
 //
 // Note on r = 1 (the paper's value for the joint wrinkles): M(s) = 1 for every s when r = 1, so
 // the joint wrinkles keep their full height in every pose; the response to the motion then comes
@@ -39,22 +39,25 @@ struct HandRigParams {
   double max_flexion = 1.3;       // finger bone rotation at flexion 1 [rad] (thumb: half)
   // Large-scale joint wrinkles (paper §8: d, w in 0.5-1 mm, r = 1).
   bool joint_wrinkles = true;
-  double joint_depth = 0.8e-3;      // d [m]
-  double joint_width = 0.7e-3;      // w [m]
-  double joint_r = 1.0;             // (2.4) r of every joint wrinkle
-  int creases_per_joint = 3;        // parallel furrows at each joint
-  double crease_spacing = 2.2e-3;   // between them, along the finger [m]
-  double crease_half_arc = 0.9;     // half the angle the furrow spans around the finger [rad]
-  double joint_end_taper = 0.3;     // LargeWrinkle::end_taper
-  bool palmar_creases = false;      // also furrows on the palm side of each joint
-  RefineParams refine{3, 0.6, 5.0};
+  double joint_depth = 0.8e-3;     // d [m]
+  double joint_width = 0.7e-3;     // w [m]
+  double joint_r = 1.0;            // (2.4) r of every joint wrinkle
+  int creases_per_joint = 3;       // parallel furrows at each joint
+  double crease_spacing = 2.2e-3;  // between them, along the finger [m]
+  double crease_half_arc = 0.9;    // half the angle the furrow spans around the finger [rad]
+  double joint_end_taper = 0.3;    // LargeWrinkle::end_taper
+  bool palmar_creases = false;     // also furrows on the palm side of each joint
+  RefineParams refine{3, 0.75, 4.0};
   // Fine-scale wrinkles: field 0 runs around the fingers / across the back of the hand, field 1
   // at fine_angle from it toward the bone direction; magnitudes m (2.5).
-  FineWrinkleParams fine{1024, 1.0, 0.3, 200, true, 100e-6, 0.5};
+  FineWrinkleParams fine{1024, 1.0, 0.3, 200, true, 200e-6, 0.5};
   double fine_m0 = 0.5;
   double fine_m1 = 0.4;
   double fine_angle = 1.0;  // [rad]
   int fine_key_stride = 8;  // a direction key on every k-th uv vertex
+  // Bump strength for rendering / normal-map export of the fine relief (the paper enhances the
+  // bump mapping "excessively" in Fig. 2.17 so the fine wrinkles are clearly visible).
+  double bump_strength = 3.0;
 
   template <class V>
   void visit(V&& v) {
@@ -67,8 +70,8 @@ struct HandRigParams {
     v("joint_r", joint_r, ParamInfo{"joint wrinkle rest ratio r (2.4)", "", 0, 1});
     v("creases_per_joint", creases_per_joint, ParamInfo{"furrows per joint", "", 1, 8});
     v("crease_spacing", crease_spacing, ParamInfo{"spacing of a joint's furrows", "m", 0, 0.02});
-    v("crease_half_arc", crease_half_arc, ParamInfo{"furrow half arc around the finger", "rad",
-                                                    0.1, 1.5});
+    v("crease_half_arc", crease_half_arc,
+      ParamInfo{"furrow half arc around the finger", "rad", 0.1, 1.5});
     v("joint_end_taper", joint_end_taper, ParamInfo{"furrow end taper", "", 0, 0.5});
     v("palmar_creases", palmar_creases, ParamInfo{"furrows on the palm side too", ""});
     v("refine", refine, ParamInfo{"adaptive refinement around joint wrinkles", ""});
@@ -76,8 +79,9 @@ struct HandRigParams {
     v("fine_m0", fine_m0, ParamInfo{"field 0 direction magnitude", "", 0, 1});
     v("fine_m1", fine_m1, ParamInfo{"field 1 direction magnitude", "", 0, 1});
     v("fine_angle", fine_angle, ParamInfo{"field 1 angle from field 0", "rad", -3.2, 3.2});
-    v("fine_key_stride", fine_key_stride, ParamInfo{"direction key every k uv vertices", "", 1,
-                                                    1000});
+    v("bump_strength", bump_strength, ParamInfo{"fine relief bump strength", "", 0, 100});
+    v("fine_key_stride", fine_key_stride,
+      ParamInfo{"direction key every k uv vertices", "", 1, 1000});
   }
   void validate() const { validate_params(*this, "hand_rig"); }
 };
@@ -85,12 +89,12 @@ struct HandRigParams {
 /// Per-frame state (also scratch; reuse across frames).
 struct HandState {
   double flexion = 0;
-  std::vector<Vec3> animated;          // skinned surface (no wrinkles)
-  std::vector<Vec3> positions;         // final surface with joint wrinkles [m]
-  std::vector<Vec3> normals;           // of `positions`
-  std::vector<double> joint_height;    // sum of M(s) S(l) per vertex [m]
+  std::vector<Vec3> animated;                        // skinned surface (no wrinkles)
+  std::vector<Vec3> positions;                       // final surface with joint wrinkles [m]
+  std::vector<Vec3> normals;                         // of `positions`
+  std::vector<double> joint_height;                  // sum of M(s) S(l) per vertex [m]
   std::array<std::vector<float>, 2> fine_shrinkage;  // (2.3) per uv vertex, per field
-  image::ImageF relief;                // modulated fine relief, units of depth_m (if requested)
+  image::ImageF relief;  // modulated fine relief, units of depth_m (if requested)
   // scratch
   std::vector<Vec3> face_n;
   std::vector<double> face_area;
@@ -105,15 +109,16 @@ struct HandUpdateOptions {
 /// What the renderer needs for one frame (scene::Session turns it into a render::MeshItem with
 /// material.height_map = height_m and bump_strength).
 struct HandFrame {
-  std::shared_ptr<const geom::TriMesh> mesh;     // deformed, with normals and the rig's UVs
+  std::shared_ptr<const geom::TriMesh> mesh;      // deformed, with normals and the rig's UVs
   std::shared_ptr<const image::ImageF> height_m;  // fine-wrinkle relief [m] (null: none)
   double flexion = 0;
+  double bump_strength = 1.0;  // for material.bump_strength (HandRigParams::bump_strength)
 };
 
 /// A finger-joint wrinkle with the joint it belongs to.
 struct JointWrinkleInfo {
-  std::string bone;  // the bone whose head is the joint
-  int crease = 0;    // index among the joint's parallel furrows
+  std::string bone;     // the bone whose head is the joint
+  int crease = 0;       // index among the joint's parallel furrows
   bool palmar = false;  // on the palm side (else the back of the finger)
 };
 
@@ -164,6 +169,7 @@ class HandRig {
   anim::SubMesh m_hand;
   RefinedMesh m_refined;
   geom::TriMesh m_rest;
+  std::vector<Vec3> m_rest_normals;
   anim::SkinWeights m_weights;
   std::vector<LargeWrinkle> m_wrinkles;
   std::vector<JointWrinkleInfo> m_info;

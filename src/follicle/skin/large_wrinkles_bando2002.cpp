@@ -112,6 +112,27 @@ WrinkleLayer::WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> 
     m_wrinkles[i].validate();
     build(i);
   }
+  build_vertex_index();
+}
+
+void WrinkleLayer::build_vertex_index() {
+  const std::size_t nv = m_rest.positions.size();
+  std::vector<std::size_t> count(nv + 1, 0);
+  for (const auto& infl : m_infl)
+    for (const auto& e : infl.entries) ++count[std::size_t(e.vertex) + 1];
+  m_vtx.clear();
+  m_vtx_offsets.assign(1, 0);
+  std::vector<std::size_t> slot(nv, 0);
+  for (std::size_t v = 0; v < nv; ++v)
+    if (count[v + 1] > 0) {
+      slot[v] = m_vtx_offsets.back();
+      m_vtx.push_back(int(v));
+      m_vtx_offsets.push_back(m_vtx_offsets.back() + count[v + 1]);
+    }
+  m_vtx_refs.resize(m_vtx_offsets.back());
+  for (std::size_t i = 0; i < m_infl.size(); ++i)  // wrinkle order within each vertex
+    for (std::size_t k = 0; k < m_infl[i].entries.size(); ++k)
+      m_vtx_refs[slot[std::size_t(m_infl[i].entries[k].vertex)]++] = {int(i), int(k)};
 }
 
 std::size_t WrinkleLayer::set_wrinkle(std::size_t i, const LargeWrinkle& w) {
@@ -121,6 +142,7 @@ std::size_t WrinkleLayer::set_wrinkle(std::size_t i, const LargeWrinkle& w) {
   const std::size_t before = m_infl[i].entries.size();
   m_wrinkles[i] = w;
   build(i);
+  build_vertex_index();  // O(entries): no geometry is recomputed for the other wrinkles
   return std::max(before, m_infl[i].entries.size());
 }
 
@@ -209,29 +231,27 @@ void WrinkleLayer::build(std::size_t i) {
   m_infl[i] = std::move(infl);
 }
 
+double WrinkleLayer::entry_shrinkage(const WrinkleInfluence::Entry& e,
+                                     const std::vector<Vec3>& p) const {
+  double acc = 0;
+  const Vec3& p1 = p[std::size_t(e.vertex)];
+  for (int j = 0; j < e.nsides; ++j) {
+    const auto& sd = e.side[std::size_t(j)];
+    const Vec3 x2 = p[std::size_t(sd.j2)] - p1, x3 = p[std::size_t(sd.j3)] - p1;
+    if (m_method == ShrinkageMethod::edge_scaling)
+      acc += triangle_shrinkage(sd.a, sd.b, x2.norm() / sd.rest2, x3.norm() / sd.rest3);  // (2.3)
+    else
+      acc += 1.0 - (sd.a * x2 + sd.b * x3).norm() / sd.rest_span;  // (2.3) s = 1 - L'/L
+  }
+  return e.nsides > 0 ? acc / e.nsides : 0.0;  // average of the +d_p and -d_p triangles
+}
+
 void WrinkleLayer::shrinkage(const Context& ctx, std::size_t i, const std::vector<Vec3>& p,
                              std::vector<double>& s) const {
   const auto& entries = m_infl[i].entries;
   s.resize(entries.size());
   parallel_for(
-      ctx, 0, entries.size(),
-      [&](std::size_t k) {
-        const auto& e = entries[k];
-        double acc = 0;
-        const Vec3& p1 = p[std::size_t(e.vertex)];
-        for (int j = 0; j < e.nsides; ++j) {
-          const auto& sd = e.side[std::size_t(j)];
-          const Vec3 x2 = p[std::size_t(sd.j2)] - p1, x3 = p[std::size_t(sd.j3)] - p1;
-          if (m_method == ShrinkageMethod::edge_scaling) {
-            acc += triangle_shrinkage(sd.a, sd.b, x2.norm() / sd.rest2,
-                                      x3.norm() / sd.rest3);  // (2.3)
-          } else {
-            acc += 1.0 - (sd.a * x2 + sd.b * x3).norm() / sd.rest_span;  // (2.3) s = 1 - L'/L
-          }
-        }
-        s[k] = e.nsides > 0 ? acc / e.nsides : 0.0;  // average of the +d_p and -d_p triangles
-      },
-      512);
+      ctx, 0, entries.size(), [&](std::size_t k) { s[k] = entry_shrinkage(entries[k], p); }, 512);
 }
 
 void WrinkleLayer::heights(const Context& ctx, const std::vector<Vec3>& deformed,
@@ -240,16 +260,21 @@ void WrinkleLayer::heights(const Context& ctx, const std::vector<Vec3>& deformed
     fail("wrinkle heights: {} positions for a {}-vertex rest mesh", deformed.size(),
          m_rest.positions.size());
   height.assign(deformed.size(), 0.0);
-  std::vector<double> s;
-  for (std::size_t i = 0; i < m_wrinkles.size(); ++i) {
-    shrinkage(ctx, i, deformed, s);
-    const double r = m_wrinkles[i].r;
-    const auto& entries = m_infl[i].entries;
-    // Fixed wrinkle order, sequential accumulation: bit-identical for any thread count.
-    for (std::size_t k = 0; k < entries.size(); ++k)
-      height[std::size_t(entries[k].vertex)] +=
-          amplitude_modulation(s[k], r) * entries[k].shape;  // (2.4)
-  }
+  // One pass over the affected vertices; each sums its wrinkles in wrinkle order, so the result
+  // is bit-identical for any thread count (and to a wrinkle-by-wrinkle accumulation).
+  parallel_for(
+      ctx, 0, m_vtx.size(),
+      [&](std::size_t j) {
+        double h = 0;
+        for (std::size_t q = m_vtx_offsets[j]; q < m_vtx_offsets[j + 1]; ++q) {
+          const auto [wi, k] = m_vtx_refs[q];
+          const auto& e = m_infl[std::size_t(wi)].entries[std::size_t(k)];
+          h += amplitude_modulation(entry_shrinkage(e, deformed), m_wrinkles[std::size_t(wi)].r) *
+               e.shape;  // (2.4) M(s) S(l)
+        }
+        height[std::size_t(m_vtx[j])] = h;
+      },
+      512);
 }
 
 void WrinkleLayer::rest_heights(std::vector<double>& height) const {

@@ -107,7 +107,14 @@ class WrinkleLayer {
 
  private:
   void build(std::size_t i);
+  void build_vertex_index();
+  double entry_shrinkage(const WrinkleInfluence::Entry& e, const std::vector<Vec3>& p) const;
   geom::TriMesh m_rest;
+  // Vertex -> (wrinkle, entry) lists over the affected vertices, in wrinkle order, so heights()
+  // is one parallel pass that sums each vertex's wrinkles in a fixed order (deterministic).
+  std::vector<int> m_vtx;
+  std::vector<std::size_t> m_vtx_offsets;
+  std::vector<std::pair<int, int>> m_vtx_refs;
   TextureSpaceMesh m_tex;
   std::vector<LargeWrinkle> m_wrinkles;
   std::vector<WrinkleInfluence> m_infl;

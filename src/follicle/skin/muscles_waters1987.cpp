@@ -155,7 +155,7 @@ double sphincter_factor(const SphincterMuscle& m, const Vec3& p, Vec3* pull) {
     f = 0.5 * (1.0 + std::cos((rho - m.falloff_start) / (1.0 - m.falloff_start) * kPi));
   const double zt = std::clamp((z - 0.5 * m.depth) / (0.5 * m.depth), 0.0, 1.0);
   f *= 1.0 - zt * zt * (3.0 - 2.0 * zt);  // smooth fade across the depth limit
-  *pull = -(x * ea + y * eb);  // toward the centre within the ellipse plane
+  *pull = -(x * ea + y * eb);             // toward the centre within the ellipse plane
   return f;
 }
 

@@ -50,8 +50,8 @@ struct LinearMuscle {
 
 /// Sphincter muscle (elliptical, Waters 1987): pulls vertices inside the ellipse toward its
 /// centre within the ellipse plane: delta = k * F(rho) * G(z) * (c - p)_plane with
-/// rho = sqrt((x/a)^2 + (y/b)^2), F = 1 for rho <= falloff_start, (1 + cos(pi (rho - fs)/(1 - fs)))/2
-/// up to rho = 1, 0 outside, and G = 1 - smoothstep((|z| - depth/2) / (depth/2)) across the
+/// rho = sqrt((x/a)^2 + (y/b)^2), F = 1 for rho <= falloff_start, (1 + cos(pi (rho - fs)/(1 -
+/// fs)))/2 up to rho = 1, 0 outside, and G = 1 - smoothstep((|z| - depth/2) / (depth/2)) across the
 /// ellipse plane (z = distance along its normal). F and G reach 0 with zero slope: no crease at
 /// the ellipse outline or at the depth limit.
 struct SphincterMuscle {

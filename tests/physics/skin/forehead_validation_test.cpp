@@ -15,8 +15,10 @@ TEST(ForeheadValidation, GeneratedFurrowsMatchAnalyticProfile) {
   ForeheadCaseParams p;
   const ForeheadCase c = make_forehead_case(ctx, p);
   EXPECT_NEAR(amplitude_modulation(p.shrink, p.r) * p.depth, 0.005, 1e-12);  // 5 mm deep
-  EXPECT_NEAR(c.mean_shrinkage, p.shrink, 1e-9);
-  EXPECT_LT(c.max_shrinkage_error, 1e-9);
+  // Exact up to the smooth (PN-triangle) refinement: new vertices sit on the curved patch within
+  // ~1 um instead of on its flat facets, which changes L'/L by ~1e-5.
+  EXPECT_NEAR(c.mean_shrinkage, p.shrink, 1e-4);
+  EXPECT_LT(c.max_shrinkage_error, 1e-4);
   EXPECT_GT(c.generated.faces.size(), c.rest.faces.size());  // refined around the furrows
   geom::MeshDistanceParams dp;
   dp.samples = 50000;

@@ -244,6 +244,29 @@ TEST_F(MakeHumanTest, HandExtractionAndFlexion) {
   EXPECT_DOUBLE_EQ(track.value(0.0), 0.0);
 }
 
+TEST_F(MakeHumanTest, FingersCurlTowardThePalmOnBothHands) {
+  // The palm normal by the hand rule (left hand: the palm faces F x T, F = wrist -> fingers,
+  // T = little -> index finger; checked visually: flexed renders show the back of the hand with
+  // the fingers curling away): the middle finger tip must move to the palm side. Both hands
+  // must flex as mirror images (the mesh is x-symmetric).
+  Context ctx(1);
+  double tip_move[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    const Side side = k == 0 ? Side::left : Side::right;
+    const std::string sfx = k == 0 ? ".L" : ".R";
+    const auto& b = skel->bones();
+    const Vec3 F = b[skel->index("finger3-1" + sfx)].head - b[skel->index("wrist" + sfx)].head;
+    const Vec3 T = b[skel->index("finger2-1" + sfx)].head - b[skel->index("finger5-1" + sfx)].head;
+    const Vec3 palm = (k == 0 ? F.cross(T) : T.cross(F)).normalized();
+    const auto xf = skinning_transforms(*skel, finger_flexion_pose(*skel, side, 0.3));
+    const Vec3 tip = b[skel->index("finger3-3" + sfx)].tail;
+    const Vec3 moved = xf.apply(skel->index("finger3-3" + sfx), tip) - tip;
+    EXPECT_GT(moved.normalized().dot(palm), 0.5) << sfx;
+    tip_move[k] = moved.x();
+  }
+  EXPECT_NEAR(tip_move[0], -tip_move[1], 1e-3);
+}
+
 TEST(MakeHumanLoad, BadInputsNameTheFile) {
   const auto dir = test::scratch_dir("mh_bad");
   { std::ofstream(dir / "bad.obj") << "v 1 2 3\nvt 0 0\ng body\nf 1/1 2/1 3/1\n"; }

@@ -58,7 +58,7 @@ inline LcpScene lcp_small_scene(const Context& ctx, double spacing = 0.012, doub
   s.head = lcp_sphere(0.1);
   hair::ScalpParams sp;
   sp.max_length = length;
-  sp.root_depth = std::getenv("SR") ? std::atof(std::getenv("SR")) : 0.012;
+  sp.root_depth = 0.012;
   s.scalp = hair::Scalp::trim(s.head, lcp_cap_curves(0.1, 1.1), sp);
   sim::VoxelPlanesParams vp;
   vp.voxel_size = 0.01;

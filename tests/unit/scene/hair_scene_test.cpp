@@ -13,7 +13,9 @@ using ::testing::HasSubstr;
 
 namespace {
 
-std::filesystem::path scenes_dir() { return test::source_dir() / "data" / "scenes"; }
+std::filesystem::path scenes_dir() {
+  return test::source_dir() / "data" / "scenes";
+}
 
 Json scene_json(const std::string& name) {
   return parse_json_file(scenes_dir() / (name + ".json"));
@@ -169,7 +171,9 @@ TEST(HairScene, StrandCacheSkipsTheSimulation) {
   b.set_strand_cache(dir);
   for (int f = 0; f <= 5; ++f) {
     const auto fb = b.hair_strands(0, f);
-    if (f == 5) EXPECT_TRUE(fb->points == fa->points);
+    if (f == 5) {
+      EXPECT_TRUE(fb->points == fa->points);
+    }
   }
   EXPECT_EQ(b.hair_stats().steps, 0u);
   EXPECT_EQ(b.hair_stats().cache_reads, 6u);

@@ -96,7 +96,7 @@ TEST(SkinColor, PlaneModelAndPresets) {
 TEST(SkinJson, DefaultHeadSetupLoads) {
   const FaceSetup s = load_face_setup(test::source_dir() / "data/muscles/lee_perry_smith.json");
   EXPECT_EQ(s.muscles.linear.size(), 14u);
-  EXPECT_EQ(s.muscles.sphincter.size(), 1u);
+  EXPECT_EQ(s.muscles.sphincter.size(), 3u);
   EXPECT_EQ(s.wrinkles.size(), 10u);
   for (const char* e :
        {"thinking", "smile", "troubled", "angry", "surprise", "raised_brows", "frown"})

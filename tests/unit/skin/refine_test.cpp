@@ -58,11 +58,13 @@ TEST(Refine, SmoothMidpointsLieOnTheCurvedSurface) {
   flat.smooth = false;
   const RefinedMesh a = refine_around_wrinkles(base, {w}, flat);
   const RefinedMesh b = refine_around_wrinkles(base, {w}, smooth);
-  ASSERT_EQ(a.mesh.faces, b.mesh.faces);
+  EXPECT_GT(b.mesh.faces.size(), base.faces.size());
   auto worst = [&](const RefinedMesh& r) {
     double e = 0;
     for (std::size_t v = std::size_t(r.base_vertices); v < r.mesh.positions.size(); ++v) {
       const Vec3& p = r.mesh.positions[v];
+      // Interior only: at the patch border the vertex normals are one-sided.
+      if (std::abs(p.y()) > 0.016 || std::abs(std::atan2(p.x(), p.z()) * R) > 0.021) continue;
       e = std::max(e, std::abs(std::hypot(p.x(), p.z()) - R));  // cylinder axis = y
     }
     return e;

@@ -1,0 +1,125 @@
+// Bando 2003 LCP hair workloads (issue 6): "lcp-step" (one leapfrog sub-step of the back hair,
+// about 2,000 particles, hair-hair interaction and body collision on) and "lcp-wind" (one coupled
+// step: SPH air + a block of hanging hair strands, 100,000 hair + 25,000 air particles).
+#include <cmath>
+#include <memory>
+
+#include "follicle/hair/lcp_bando2003.hpp"
+#include "follicle/hair/lcp_scenario_bando2003.hpp"
+#include "follicle/hair/sph_air_bando2003.hpp"
+#include "workloads/workload.hpp"
+
+namespace follicle::workloads {
+
+namespace {
+
+class LcpStepInstance : public WorkloadInstance {
+ public:
+  LcpStepInstance(const Context& ctx, const Sizes& s) : m_ctx(ctx) {
+    // The particle count scales as spacing^-3: one correction from a trial scene.
+    const double target = s.at("particles");
+    hair::LcpScenarioParams sp;
+    sp.spacing = 0.012;
+    const double n0 = double(hair::LcpScenario(ctx, sp).state().x.size());
+    sp.spacing = 0.012 * std::cbrt(n0 / target);
+    m_scene = std::make_unique<hair::LcpScenario>(ctx, sp, fixed_params());
+    for (int k = 0; k < 20; ++k) m_scene->step(ctx, 1e-3);  // leave the rest state
+    m_n = double(m_scene->state().x.size());
+  }
+  static hair::LcpParams fixed_params() {
+    hair::LcpParams p;
+    p.substeps = 1;  // one sub-step per iteration: the cost the CFL sub-stepping multiplies
+    p.cfl = 0;
+    return p;
+  }
+  void run_once() override { m_scene->step(m_ctx, 1e-4); }
+  double items_per_iter() const override { return m_n; }
+  double particles() const { return m_n; }
+
+ private:
+  const Context& m_ctx;
+  std::unique_ptr<hair::LcpScenario> m_scene;
+  double m_n = 0;
+};
+
+// A block of hanging strands (lattice, spacing a) in an SPH wind; one hair sub-step and one air
+// step per iteration.
+class LcpWindInstance : public WorkloadInstance {
+ public:
+  LcpWindInstance(const Context& ctx, const Sizes& s) : m_ctx(ctx) {
+    const double a = 0.005;
+    const int len = 100;  // particles per strand
+    const int strands = std::max(1, int(std::lround(s.at("hair") / len)));
+    const int nx = std::max(1, int(std::lround(std::sqrt(strands * 2.5)))),
+              nz = std::max(1, strands / nx);
+    std::vector<Vec3> x, t, uvs;
+    for (int k = 0; k < len; ++k)
+      for (int j = 0; j < nz; ++j)
+        for (int i = 0; i < nx; ++i) {
+          x.push_back(Vec3(a * i, -a * k, a * j));
+          t.push_back(-Vec3::UnitY());
+          uvs.push_back(Vec3(double(i) / nx, double(j) / nz, a * (k - 1.5)));
+        }
+    hair::LcpInitParams ip;
+    ip.spacing = a;
+    std::vector<double> mass(x.size(), 0.05 / double(x.size()));
+    hair::LcpParams p;
+    p.substeps = 1;
+    p.cfl = 0;
+    m_solver =
+        std::make_unique<hair::LcpSolver>(p, hair::connect_particles(ctx, x, t, uvs, mass, ip));
+    m_state = m_solver->rest_state();
+    // Air box around the block, spacing chosen for the requested air particle count.
+    hair::SphAirParams ap;
+    ap.wind_velocity = Vec3(0, 0, -3);
+    ap.box_min = Vec3(-0.05, -a * len - 0.05, -0.1);
+    ap.box_max = Vec3(a * nx + 0.05, 0.05, a * nz + 0.1);
+    const Vec3 ext = ap.box_max - ap.box_min;
+    ap.spacing = std::cbrt(ext.prod() / s.at("air"));
+    ap.coupling_radius = std::min(ap.spacing, 2 * a);
+    ap.max_particles = int(2 * s.at("air")) + 1000;
+    m_air = std::make_unique<hair::SphAir>(ctx, ap);
+    m_nh = double(x.size());
+    m_na = double(m_air->size());
+  }
+  void run_once() override {
+    const double dt = 2e-4;
+    m_air->step(m_ctx, dt, m_state.x, m_state.v, m_solver->model().mass, &m_force);
+    hair::LcpStepInput in;
+    in.dt = dt;
+    in.external_force = &m_force;
+    m_solver->step(m_ctx, in, m_state, m_ws);
+  }
+  double items_per_iter() const override { return 1.0; }
+
+ private:
+  const Context& m_ctx;
+  std::unique_ptr<hair::LcpSolver> m_solver;
+  hair::LcpState m_state;
+  hair::LcpWorkspace m_ws;
+  std::unique_ptr<hair::SphAir> m_air;
+  std::vector<Vec3> m_force;
+  double m_nh = 0, m_na = 0;
+};
+
+}  // namespace
+
+void add_lcp_workloads(std::vector<Workload>& out) {
+  out.push_back(
+      {"lcp-step",
+       "LCP hair (Bando 2003): one leapfrog sub-step of the back hair, hair-hair + body on",
+       {{"particles", 2000}},
+       "particles/s",
+       [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
+         return std::make_unique<LcpStepInstance>(ctx, s);
+       }});
+  out.push_back({"lcp-wind",
+                 "LCP hair in SPH wind (Bando 2003 §3.6): one coupled air + hair step",
+                 {{"hair", 100000}, {"air", 25000}},
+                 "steps/s",
+                 [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
+                   return std::make_unique<LcpWindInstance>(ctx, s);
+                 }});
+}
+
+}  // namespace follicle::workloads

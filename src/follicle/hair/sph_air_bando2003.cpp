@@ -1,0 +1,196 @@
+#include "follicle/hair/sph_air_bando2003.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "follicle/core/error.hpp"
+#include "follicle/core/parallel.hpp"
+#include "follicle/hair/sph_kernel.hpp"
+
+namespace follicle::hair {
+
+void SphAirParams::validate() const {
+  validate_params(*this, "sph_air");
+  for (int k = 0; k < 3; ++k)
+    if (!(box_max[k] > box_min[k] + spacing))
+      fail_at("sph_air.box_max", "box must be larger than one spacing along every axis");
+  if (wind_velocity.norm() < 1e-9) fail_at("sph_air.wind_velocity", "must not be zero");
+}
+
+SphAir::SphAir(const Context& ctx, const SphAirParams& params) : m_p(params) {
+  m_p.validate();
+  m_axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(m_p.wind_velocity[k]) > std::abs(m_p.wind_velocity[m_axis])) m_axis = k;
+  m_sign = m_p.wind_velocity[m_axis] > 0 ? 1.0 : -1.0;
+  const double a = m_p.spacing;
+  m_mass = m_p.air_density * a * a * a;
+  m_h = m_p.h_factor * a;
+  const Vec3 ext = m_p.box_max - m_p.box_min;
+  double count = 1;
+  for (int k = 0; k < 3; ++k) count *= std::floor(ext[k] / a);
+  if (count > double(m_p.max_particles))
+    fail_at("sph_air.spacing", "the box needs {} air particles, more than max_particles = {}",
+            count, m_p.max_particles);
+  // Fill the box layer by layer along the wind axis (deterministic order).
+  const int nl = int(std::floor(ext[m_axis] / a));
+  m_phase = 0.5 * a;  // the newest layer sits half a spacing inside the inflow face
+  for (int l = 0; l < nl; ++l) spawn_layer((l + 0.5) * a);
+  // rho0: the density of an interior lattice particle (3.1), so the resting lattice has P = 0.
+  double rho = 0;
+  const int r = int(std::ceil(2 * m_h / a));
+  for (int i = -r; i <= r; ++i)
+    for (int j = -r; j <= r; ++j)
+      for (int k = -r; k <= r; ++k)
+        rho += m_mass * sph_w(m_h, a * std::sqrt(double(i * i + j * j + k * k)));
+  m_rho0 = rho;
+  (void)ctx;
+}
+
+void SphAir::spawn_layer(double offset) {
+  // A lattice layer at distance `offset` downstream of the inflow face.
+  const double a = m_p.spacing;
+  const int u = (m_axis + 1) % 3, w = (m_axis + 2) % 3;
+  const Vec3 ext = m_p.box_max - m_p.box_min;
+  const int nu = int(std::floor(ext[u] / a)), nw = int(std::floor(ext[w] / a));
+  const double face = m_sign > 0 ? m_p.box_min[m_axis] : m_p.box_max[m_axis];
+  for (int j = 0; j < nw; ++j)
+    for (int i = 0; i < nu; ++i) {
+      if (int(m_x.size()) >= m_p.max_particles) return;
+      Vec3 x;
+      x[m_axis] = face + m_sign * offset;
+      x[u] = m_p.box_min[u] + (i + 0.5) * a;
+      x[w] = m_p.box_min[w] + (j + 0.5) * a;
+      m_x.push_back(x);
+      m_v.push_back(m_p.wind_velocity);
+    }
+}
+
+Vec3 SphAir::mean_velocity_in(const Vec3& lo, const Vec3& hi, std::size_t* count) const {
+  Vec3 s = Vec3::Zero();
+  std::size_t c = 0;
+  for (std::size_t i = 0; i < m_x.size(); ++i)
+    if ((m_x[i].array() >= lo.array()).all() && (m_x[i].array() <= hi.array()).all()) {
+      s += m_v[i];
+      ++c;
+    }
+  if (count) *count = c;
+  return c ? Vec3(s / double(c)) : Vec3::Zero();
+}
+
+Vec3 SphAir::momentum() const {
+  Vec3 p = Vec3::Zero();
+  for (const auto& v : m_v) p += m_mass * v;
+  return p;
+}
+
+sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Vec3>& hair_x,
+                             const std::vector<Vec3>& hair_v, const std::vector<double>& hair_mass,
+                             std::vector<Vec3>* force_on_hair) {
+  sim::StepReport rep;
+  const std::size_t nh = hair_x.size();
+  if (hair_v.size() != nh || hair_mass.size() != nh || !(dt > 0) || !std::isfinite(dt)) {
+    rep.ok = false;
+    rep.message = "sph_air: hair arrays differ in size or dt is not > 0";
+    return rep;
+  }
+  if (force_on_hair) force_on_hair->assign(nh, Vec3::Zero());
+  const double rc = m_p.coupling_radius, wc0 = sph_w(rc / 2, 0.0);
+  const double h = m_h, cs = std::sqrt(m_p.k_p);
+  std::vector<Vec3> impulse(nh, Vec3::Zero());
+  if (nh) m_hair_grid.build(hair_x, rc);
+  double t = 0;
+  int guard = 0;
+  while (t < dt - 1e-12 && guard++ < 100000) {
+    const std::size_t n = m_x.size();
+    double vmax = 0;
+    for (const auto& v : m_v) vmax = std::max(vmax, v.norm());
+    double sub = m_p.cfl * h / (cs + vmax + 1e-9);
+    if (m_p.drag > 0 && nh) sub = std::min(sub, m_p.cfl / m_p.drag);
+    sub = std::min(sub, dt - t);
+    // Air-air: density (3.1) and pressure (no tension).
+    const double cell = std::max(2 * h, rc);
+    m_grid.build(m_x, cell);
+    m_grid.neighbour_lists(ctx, m_x, 2 * h, m_off, m_nb);
+    m_rho.resize(n);
+    m_pr.resize(n);
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      double rho = m_mass * sph_w(h, 0.0);
+      for (uint32_t e = m_off[i]; e < m_off[i + 1]; ++e)
+        rho += m_mass * sph_w(h, (m_x[m_nb[e]] - m_x[i]).norm());  // (3.1)
+      m_rho[i] = rho;
+      m_pr[i] = m_p.k_p * std::max(rho - m_rho0, 0.0);
+    });
+    // Air-hair neighbour lists, both ways (the same pair term, so forces are equal and opposite).
+    if (nh) {
+      m_hair_grid.cross_lists(ctx, m_x, hair_x, rc, m_aoff, m_anb);  // air -> hair
+      m_grid.cross_lists(ctx, hair_x, m_x, rc, m_hoff, m_hnb);       // hair -> air
+    }
+    auto drag_on_hair = [&](std::size_t hi, std::size_t ai) -> Vec3 {
+      const double r = (m_x[ai] - hair_x[hi]).norm();
+      const double mu = hair_mass[hi] * m_mass / (hair_mass[hi] + m_mass);
+      return m_p.drag * mu * (sph_w(rc / 2, r) / wc0) * (m_v[ai] - hair_v[hi]);
+    };
+    m_acc.resize(n);
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      Vec3 f = Vec3::Zero();
+      const double pi = m_pr[i] / (m_rho[i] * m_rho[i]);
+      for (uint32_t e = m_off[i]; e < m_off[i + 1]; ++e) {
+        const uint32_t j = m_nb[e];
+        const Vec3 d = m_x[j] - m_x[i];
+        const double r = d.norm();
+        if (r <= 0) continue;
+        // (3.16) -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) grad_i W, grad_i W = -W'(r) d/r
+        f += m_mass * m_mass * (pi + m_pr[j] / (m_rho[j] * m_rho[j])) * sph_dw(h, r) * d / r;
+      }
+      if (nh)
+        for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) f -= drag_on_hair(m_anb[e], i);
+      m_acc[i] = f / m_mass;
+    });
+    if (nh)
+      parallel_for(ctx, 0, nh, [&](std::size_t hi) {
+        Vec3 f = Vec3::Zero();
+        for (uint32_t e = m_hoff[hi]; e < m_hoff[hi + 1]; ++e) f += drag_on_hair(hi, m_hnb[e]);
+        impulse[hi] += f * sub;
+      });
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      m_v[i] += m_acc[i] * sub;  // symplectic Euler (leapfrog in kick-drift form)
+      m_x[i] += m_v[i] * sub;
+    });
+    t += sub;
+    // Remove particles that left the box (order kept: deterministic), then feed the inflow.
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool bad = !m_x[i].allFinite() || !m_v[i].allFinite() || m_v[i].norm() > m_p.max_speed;
+      if (bad) {
+        if (m_v[i].allFinite() && m_x[i].allFinite())
+          rep.mark_blow_up(i);
+        else
+          rep.mark_non_finite(i);
+      }
+      rep.max_speed = std::max(rep.max_speed, std::isfinite(m_v[i].norm()) ? m_v[i].norm() : 0.0);
+      if ((m_x[i].array() < m_p.box_min.array()).any() ||
+          (m_x[i].array() > m_p.box_max.array()).any())
+        continue;
+      m_x[k] = m_x[i];
+      m_v[k] = m_v[i];
+      ++k;
+    }
+    if (!rep.ok) {
+      rep.finish("sph_air", m_p.max_speed);
+      return rep;
+    }
+    m_x.resize(k);
+    m_v.resize(k);
+    m_phase += std::abs(m_p.wind_velocity[m_axis]) * sub;
+    while (m_phase >= m_p.spacing) {
+      m_phase -= m_p.spacing;
+      spawn_layer(m_phase);
+    }
+  }
+  if (force_on_hair)
+    for (std::size_t i = 0; i < nh; ++i) (*force_on_hair)[i] = impulse[i] / dt;
+  return rep;
+}
+
+}  // namespace follicle::hair
