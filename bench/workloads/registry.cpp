@@ -14,6 +14,8 @@ void add_fine_workloads(std::vector<Workload>& out);
 void add_anjyo_workloads(std::vector<Workload>& out);
 void add_skin_workloads(std::vector<Workload>& out);
 void add_splat_workloads(std::vector<Workload>& out);
+void add_lcp_workloads(std::vector<Workload>& out);
+void add_hair_render_workloads(std::vector<Workload>& out);
 
 std::vector<Workload> all_workloads() {
   std::vector<Workload> out;
@@ -23,6 +25,8 @@ std::vector<Workload> all_workloads() {
   add_anjyo_workloads(out);
   add_skin_workloads(out);
   add_splat_workloads(out);
+  add_lcp_workloads(out);
+  add_hair_render_workloads(out);
   return out;
 }
 
