@@ -84,7 +84,7 @@ TEST_F(GoldenRender, BasicSceneMatchesGolden) {
     image::write_png(golden, img);
     GTEST_SKIP() << "golden image written to " << golden;
   }
-  if (!std::filesystem::exists(golden)) GTEST_SKIP() << "no golden image " << golden;
+  ASSERT_TRUE(std::filesystem::exists(golden)) << "no golden image " << golden;
   const std::string tol = read_file(dir / "scene_basic.tolerance.json");
   image::DiffOptions opt;
   opt.threshold = json_number(tol, "pixel_threshold");

@@ -12,6 +12,7 @@
 #include "follicle/render/renderer.hpp"
 #include "follicle/scene/json_params.hpp"
 #include "follicle/scene/session.hpp"
+#include "testing/gl_testing.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
@@ -37,12 +38,7 @@ struct GoldenTolerance {
 
 TEST(DefaultSceneGolden, MatchesWithinTolerance) {
   Context ctx(2);
-  std::unique_ptr<render::Renderer> renderer;
-  try {
-    renderer = render::Renderer::create_headless(ctx);
-  } catch (const Error& e) {
-    GTEST_SKIP() << "no headless OpenGL 3.3: " << e.what();
-  }
+  FOLLICLE_HEADLESS_RENDERER_OR_SKIP(renderer, ctx);
   auto session = scene::Session::load(test::source_dir() / "data" / "scenes" / "default.json", ctx);
   const auto img = renderer->render(session.render_scene(0), session.render_settings());
   ASSERT_EQ(img.width(), session.scene().render.width);

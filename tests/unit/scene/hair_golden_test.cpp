@@ -12,6 +12,7 @@
 #include "follicle/render/renderer.hpp"
 #include "follicle/scene/json_params.hpp"
 #include "follicle/scene/session.hpp"
+#include "testing/gl_testing.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
@@ -35,12 +36,7 @@ struct GoldenTolerance {
 
 void check_golden(const std::string& name, double density) {
   Context ctx(2);
-  std::unique_ptr<render::Renderer> renderer;
-  try {
-    renderer = render::Renderer::create_headless(ctx);
-  } catch (const Error& e) {
-    GTEST_SKIP() << "no headless OpenGL 3.3: " << e.what();
-  }
+  FOLLICLE_HEADLESS_RENDERER_OR_SKIP(renderer, ctx);
   const auto scenes = test::source_dir() / "data" / "scenes";
   scene::Json j = scene::parse_json_file(scenes / ("anjyo_" + name + ".json"));
   j["hair"][0]["density_scale"] = density;
