@@ -36,10 +36,6 @@ constexpr double kPollSeconds = 0.5;  // scene file mtime poll interval
 /// Frames in the scene's animation (1 = static). Scene files have no animation section yet;
 /// when one is added, return its frame count here and the frame slider, Space and Left/Right
 /// come alive (Session::render_scene(frame) already takes the frame).
-int scene_frame_count(const scene::Scene& /*scene*/) {
-  return 1;
-}
-
 bool same_camera(const scene::CameraSpec& a, const scene::CameraSpec& b) {
   return a.eye == b.eye && a.target == b.target && a.up == b.up && a.fov_deg == b.fov_deg &&
          a.near == b.near && a.far == b.far;
@@ -247,7 +243,7 @@ class Viewer {
           !m_session || !same_camera(m_session->scene().camera, s.scene().camera);
       m_session.emplace(std::move(s));
       m_error.clear();
-      m_frame_count = scene_frame_count(m_session->scene());
+      m_frame_count = std::max(1, m_session->frame_count());
       m_frame = std::clamp(m_frame, 0, m_frame_count - 1);
       if (m_frame_count <= 1) m_playing = false;
       m_file_camera = m_session->render_scene(0).camera;
