@@ -22,8 +22,12 @@ static void run_lcp(benchmark::State& state, const char* name) {
 static void BM_LcpStep(benchmark::State& s) {
   run_lcp(s, "lcp-step");
 }
+static void BM_LcpFrame(benchmark::State& s) {
+  run_lcp(s, "lcp-frame");
+}
 static void BM_LcpWind(benchmark::State& s) {
   run_lcp(s, "lcp-wind");
 }
 BENCHMARK(BM_LcpStep)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_LcpFrame)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_LcpWind)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();

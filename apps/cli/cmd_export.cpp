@@ -14,8 +14,14 @@
 namespace follicle::cli {
 
 int run_export(const GlobalOptions& g, const ExportArgs& a) {
+  if (a.hair.empty() && a.maps.empty())
+    throw UsageError("nothing to export: give --hair out.hair|.tfx|.usda|.obj or --maps DIR");
+  if (!a.frames.empty() && a.maps.empty()) throw UsageError("--frames applies to --maps only");
+  if (!a.maps.empty()) {
+    run_export_maps(g, a);
+    if (a.hair.empty()) return 0;
+  }
   auto ctx = make_context(g);
-  if (a.hair.empty()) throw UsageError("nothing to export: give --hair out.hair|.tfx|.usda|.obj");
   auto ext = std::filesystem::path(a.hair).extension().string();
   for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (ext != ".hair" && ext != ".tfx" && ext != ".usda" && ext != ".obj")

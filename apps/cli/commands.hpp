@@ -70,8 +70,12 @@ struct ExportArgs {
   int frame = 0;
   std::string units = "m";
   std::string cache;  // strand cache folder, "" = none
+  std::string maps;    // wrinkle-map folder, "" = none (cmd_export_maps.cpp)
+  std::string frames;  // "A-B" for --maps, "" = every frame
 };
 int run_export(const GlobalOptions& g, const ExportArgs& a);
+/// The --maps part of `follicle export` (cmd_export_maps.cpp).
+int run_export_maps(const GlobalOptions& g, const ExportArgs& a);
 
 struct AnimateArgs {
   std::string scene;

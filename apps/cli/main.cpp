@@ -80,9 +80,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   ExportArgs ea;
-  auto* exp = app.add_subcommand("export", "write a scene's hair to a strand file");
+  auto* exp = app.add_subcommand(
+      "export", "write a scene's hair to a strand file or its wrinkle maps to images");
   exp->add_option("scene", ea.scene, "scene file (.json)")->required();
-  exp->add_option("--hair", ea.hair, "output strand file: .hair, .tfx, .usda or .obj")->required();
+  exp->add_option("--hair", ea.hair, "output strand file: .hair, .tfx, .usda or .obj");
+  exp->add_option("--maps", ea.maps,
+                  "folder for height, normal and displacement maps (EXR + PNG) of the rest "
+                  "state and each frame");
+  exp->add_option("--frames", ea.frames, "frame range A-B of --maps (default: every frame)");
   exp->add_option("--frame", ea.frame, "frame of the animation")->check(CLI::NonNegativeNumber);
   exp->add_option("--units", ea.units, "length unit written to the file: mm, cm, dm, m")
       ->capture_default_str();

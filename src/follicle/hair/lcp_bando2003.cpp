@@ -425,10 +425,23 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
       m_model.adj_offsets.size() != n + 1)
     fail_at("lcp", "inconsistent particle model arrays");
   if (!(m_model.h > 0) || !(m_model.h_s > 0)) fail_at("lcp", "smoothing lengths must be > 0");
+  const std::size_t np = m_model.num_pairs();
+  if (m_model.pair_a.size() != np || m_model.pair_b.size() != np || m_model.c.size() != np ||
+      m_model.cos_a.size() != np || m_model.cos_b.size() != np ||
+      m_model.adj_offsets.back() != m_model.adj_pairs.size())
+    fail_at("lcp", "inconsistent connection arrays");
   for (std::size_t q = 0; q < m_model.num_pairs(); ++q)
     if (m_model.pair_a[q] >= n || m_model.pair_b[q] >= n)
       fail_at(fmt::format("lcp.pairs[{}]", q), "particle index out of range");
   m_rho0 = m_params.rho0_scale * m_model.rest_density;
+  m_sin_a.resize(m_model.num_pairs());
+  m_sin_b.resize(m_model.num_pairs());
+  for (std::size_t q = 0; q < m_model.num_pairs(); ++q) {
+    m_sin_a[q] = std::sqrt(std::max(0.0, 1 - m_model.cos_a[q] * m_model.cos_a[q]));
+    m_sin_b[q] = std::sqrt(std::max(0.0, 1 - m_model.cos_b[q] * m_model.cos_b[q]));
+  }
+  m_ea.resize(n);
+  for (std::size_t i = 0; i < n; ++i) m_ea[i] = m_params.elastic_modulus * cross_section(i);
 }
 
 LcpState LcpSolver::rest_state() const {
@@ -462,32 +475,40 @@ void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace&
   // race-free.
   const double k_floor_w = sph_w(m.h_s, kTetherFraction * 2 * m.h_s);
   parallel_for(ctx, 0, n, [&](std::size_t i) {
-    if (m.root[i]) return;
-    uint32_t best = uint32_t(-1);
-    double bd = 1e300;
-    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
-      const uint32_t q = m.adj_pairs[e];
-      if (m.pair_b[q] != i) continue;
-      if (ws.k[q] > 0) return;
-      const double d = (s.x[m.pair_a[q]] - s.x[i]).squaredNorm();
-      if (d < bd) {
-        bd = d;
-        best = q;
+    const uint32_t e0 = m.adj_offsets[i], e1 = m.adj_offsets[i + 1];
+    if (!m.root[i]) {
+      uint32_t best = uint32_t(-1);
+      double bd = 1e300;
+      bool held = false;
+      for (uint32_t e = e0; e < e1 && !held; ++e) {
+        const uint32_t q = m.adj_pairs[e];
+        if (m.pair_b[q] != i) continue;
+        if (ws.k[q] > 0) {
+          held = true;
+          break;
+        }
+        const double d = (s.x[m.pair_a[q]] - s.x[i]).squaredNorm();
+        if (d < bd) {
+          bd = d;
+          best = q;
+        }
       }
+      if (!held && best != uint32_t(-1)) ws.k[best] = m.c[best] * k_floor_w;
     }
-    if (best != uint32_t(-1)) ws.k[best] = m.c[best] * k_floor_w;
   });
-  const double E = m_params.elastic_modulus;
+  // (3.13), after all tethers are set (a root-side end reads k of connections whose tip-side
+  // end may have just raised them).
   parallel_for(ctx, 0, n, [&](std::size_t i) {
+    const uint32_t e0 = m.adj_offsets[i], e1 = m.adj_offsets[i + 1];
     double sr = 0, st = 0;
-    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+    for (uint32_t e = e0; e < e1; ++e) {
       const uint32_t q = m.adj_pairs[e];
       if (m.pair_b[q] == i)
         sr += m.l0[q] * ws.k[q];  // the other end is in N_r(i)
       else
         st += m.l0[q] * ws.k[q];  // the other end is in N_t(i)
     }
-    const double ea = E * cross_section(i);
+    const double ea = m_ea[i];
     ws.alpha_r[i] = sr > 0 ? ea / sr : 0.0;  // (3.13)
     ws.alpha_t[i] = st > 0 ? ea / st : 0.0;
   });
@@ -509,7 +530,7 @@ void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace&
         else
           et += c;
       }
-      const double ea = E * cross_section(i);
+      const double ea = m_ea[i];
       ws.alpha_r[i] = er > 0 ? ea / er : 1.0;  // reused as correction factors
       ws.alpha_t[i] = et > 0 ? ea / et : 1.0;
     });
@@ -538,100 +559,171 @@ void LcpSolver::tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
 
 void LcpSolver::neighbours_and_density(const Context& ctx, const LcpState& s,
                                        LcpWorkspace& ws) const {
-  const double h = m_model.h;
-  ws.grid.build(s.x, 2 * h);
-  ws.grid.neighbour_lists(ctx, s.x, 2 * h, ws.nbr_offsets, ws.nbrs);
-  const std::size_t n = m_model.size();
+  const auto& m = m_model;
+  const double h = m.h;
+  const std::size_t n = m.size();
+  // Verlet lists: all pairs within R = 2h + skin. A pair now closer than 2h was closer than
+  // 2h + 2 d_max at the build, d_max the largest displacement since; so the lists stay complete
+  // while 2 d_max < skin (rebuilt a little earlier to stay clear of rounding).
+  const double skin = m_params.neighbour_skin * 2 * h;
+  const double R = 2 * h + skin;
+  bool rebuild = skin <= 0 || ws.nbr_built_x.size() != n || ws.nbr_radius != R ||
+                 ws.nbr_offsets.size() != n + 1 || ws.nbr_mirror.size() != ws.nbrs.size();
+  if (!rebuild) {
+    const double d2 = deterministic_reduce(
+        ctx, n, 1024, 0.0,
+        [&](std::size_t i0, std::size_t i1) {
+          double d = 0;
+          for (std::size_t i = i0; i < i1; ++i)
+            d = std::max(d, (s.x[i] - ws.nbr_built_x[i]).squaredNorm());
+          return d;
+        },
+        [](double u, double w) { return std::max(u, w); });
+    const double lim = 0.49 * skin;
+    rebuild = !(d2 < lim * lim);  // also when a position is NaN
+  }
+  if (rebuild) {
+    ws.grid.build(s.x, R);
+    ws.grid.neighbour_lists(ctx, s.x, R, ws.nbr_offsets, ws.nbrs);
+    if (!sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
+      fail("lcp: neighbour lists are not symmetric (internal error)");
+    ws.nbr_built_x = s.x;
+    ws.nbr_radius = R;
+    ++ws.nbr_builds;
+  }
   ws.density.resize(n);
   ws.pressure.resize(n);
-  const double w0 = sph_w(h, 0.0);
+  ws.pair_w.resize(ws.nbrs.size());
+  const SphKernel K(h);
+  const double r2max = 4 * h * h;
+  // W once per pair (at its lower-index end), then gathered per particle in list order.
   parallel_for(ctx, 0, n, [&](std::size_t i) {
-    double rho = m_model.mass[i] * w0;
+    const Vec3 xi = s.x[i];
     for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
       const uint32_t j = ws.nbrs[e];
-      rho += m_model.mass[j] * sph_w(h, (s.x[j] - s.x[i]).norm());  // (3.1)
+      if (j < i) continue;
+      const double d2 = (s.x[j] - xi).squaredNorm();
+      ws.pair_w[e] = d2 < r2max ? K.w(std::sqrt(d2)) : 0.0;
+    }
+  });
+  const double w0 = K.w(0.0);
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    double rho = m.mass[i] * w0;
+    for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+      const uint32_t j = ws.nbrs[e];
+      rho += m.mass[j] * ws.pair_w[j > i ? e : ws.nbr_mirror[e]];  // (3.1)
     }
     ws.density[i] = rho;
     ws.pressure[i] = m_params.k_a * (rho - m_rho0);  // P = k_a (rho - rho0)
   });
 }
 
-namespace {
-
-// Force of loose spring q on its root-side end a (the tip-side end b gets the negation).
-inline Vec3 spring_force_on_a(const LcpModel& m, const LcpParams& p, const LcpState& s,
-                              const LcpWorkspace& ws, uint32_t q) {
-  const uint32_t a = m.pair_a[q], b = m.pair_b[q];
-  const Vec3 d = s.x[b] - s.x[a];
-  const double r = d.norm();
-  if (r <= 0) return Vec3::Zero();
-  const Vec3 xh = d / r;
-  const double ak = ws.alpha[q] * ws.k[q];  // current coefficient alpha_ij k_ij
-  const double ext = r - m.l0[q];
-  // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
-  const double kk = ext < 0 ? ak * p.compression_scale : ak;
-  const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
-  const double cd = 2.0 * p.spring_damping * std::sqrt(kk * mu);
-  return (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
-}
-
-// Hair-hair force (3.16)-(3.18) on particle a from particle b; always called with a < b so that
-// the pair's force is computed once per ordering and negated exactly for b.
-inline Vec3 hair_force_on_a(const LcpModel& m, const LcpParams& p, const LcpState& s,
-                            const LcpWorkspace& ws, uint32_t a, uint32_t b) {
-  const Vec3 xab = s.x[b] - s.x[a];
-  const double r = xab.norm();
-  if (r <= 0) return Vec3::Zero();
-  const Vec3 xh = xab / r;
-  const double h = m.h;
-  // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i, dW/dx_i = -W' x^_ij
-  const double pr = ws.pressure[a] / (ws.density[a] * ws.density[a]) +
-                    ws.pressure[b] / (ws.density[b] * ws.density[b]);
-  Vec3 f = m.mass[a] * m.mass[b] * pr * sph_dw(h, r) * xh;
-  // Collision direction d_n = t_i x t_j. Near-colinear hairs: the paper prints
-  // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is t_i, i.e.
-  // ALONG the hair, contradicting "normal to the hair directions". We use the part of x^_ij
-  // normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which is what the case needs.
-  Vec3 dn = s.t[a].cross(s.t[b]);
-  if (dn.norm() < p.colinear_eps) dn = xh - xh.dot(s.t[a]) * s.t[a];
-  const double dnn = dn.norm();
-  if (dnn < 1e-9) return f;
-  const Vec3 dh = dn / dnn;
-  const Vec3 vab = s.v[b] - s.v[a];
-  // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one setting
-  // works for any particle count: d_c(paper) = d_c mu / W(h, 0).
-  const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
-  const double w = sph_w(h, r) / sph_w(h, 0.0);
-  const double vn = vab.dot(dh);
-  if (vn * xab.dot(dh) < 0) f += p.collision_damping * mu * w * vn * dh;  // (3.17) inelastic
-  const Vec3 dt = vab - vn * dh;
-  f += p.friction_damping * mu * w * dt;  // (3.18) = d_f W (v_ij . d^_t) d^_t
-  return f;
-}
-
-}  // namespace
-
 void LcpSolver::pair_forces(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
+  // The caller may have built ws.nbrs itself (any order, any radius >= 2h): sort and mirror.
+  if (m_params.hair_hair && !ws.nbr_offsets.empty() &&
+      !sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
+    fail("lcp: pair_forces needs symmetric neighbour lists without self entries");
+  pair_forces_sorted(ctx, s, ws);
+}
+
+void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
   const auto& m = m_model;
-  const std::size_t n = m.size();
+  const auto& p = m_params;
+  const std::size_t n = m.size(), np = m.num_pairs();
   ws.force.resize(n);
-  const bool hh = m_params.hair_hair && !ws.nbr_offsets.empty() && ws.density.size() == n;
+  // Loose springs, once per connection: force on the root-side end a (b gets the negation).
+  ws.spring_f.resize(np);
+  parallel_for(ctx, 0, np, [&](std::size_t q) {
+    const uint32_t a = m.pair_a[q], b = m.pair_b[q];
+    const Vec3 d = s.x[b] - s.x[a];
+    const double r = d.norm();
+    if (!(r > 0)) {
+      ws.spring_f[q] = Vec3::Zero();
+      return;
+    }
+    const Vec3 xh = d / r;
+    const double ak = ws.alpha[q] * ws.k[q];  // current coefficient alpha_ij k_ij
+    const double ext = r - m.l0[q];
+    // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
+    const double kk = ext < 0 ? ak * p.compression_scale : ak;
+    const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
+    const double cd = 2.0 * p.spring_damping * std::sqrt(kk * mu);
+    ws.spring_f[q] = (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
+  });
+  const bool hh = p.hair_hair && ws.nbr_offsets.size() == n + 1 && ws.density.size() == n &&
+                  ws.pressure.size() == n && ws.nbr_mirror.size() == ws.nbrs.size();
+  if (hh) {
+    ws.p_rho2.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      ws.p_rho2[i] = ws.pressure[i] / (ws.density[i] * ws.density[i]);
+    ws.pair_f.resize(ws.nbrs.size());
+    const double h = m.h, r2max = 4 * h * h;
+    const SphKernel K(h);
+    const double inv_w0 = 1.0 / K.w(0.0);
+    const double eps2 = p.colinear_eps * p.colinear_eps;
+    // Hair-hair force (3.16)-(3.18) on i from j, once per pair (i < j); j gets the negation.
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      const Vec3 xi = s.x[i], vi = s.v[i], ti = s.t[i];
+      const double mi = m.mass[i], pi = ws.p_rho2[i];
+      for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+        const uint32_t j = ws.nbrs[e];
+        if (j < i) continue;
+        const Vec3 xab = s.x[j] - xi;
+        const double r2 = xab.squaredNorm();
+        if (!(r2 < r2max) || !(r2 > 0)) {
+          ws.pair_f[e] = Vec3::Zero();
+          continue;
+        }
+        const double r = std::sqrt(r2);
+        const Vec3 xh = xab / r;
+        double w, dw;
+        K.w_dw(r, w, dw);
+        const double mj = m.mass[j];
+        // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i,
+        // dW/dx_i = -W' x^_ij
+        Vec3 f = mi * mj * (pi + ws.p_rho2[j]) * dw * xh;
+        // Collision direction d_n = t_i x t_j. Near-colinear hairs: the paper prints
+        // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is
+        // t_i, i.e. ALONG the hair, contradicting "normal to the hair directions". We use the
+        // part of x^_ij normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which the case needs.
+        Vec3 dn = ti.cross(s.t[j]);
+        double dn2 = dn.squaredNorm();
+        if (dn2 < eps2) {
+          dn = xh - xh.dot(ti) * ti;
+          dn2 = dn.squaredNorm();
+        }
+        if (dn2 >= 1e-18) {
+          const Vec3 dh = dn / std::sqrt(dn2);
+          const Vec3 vab = s.v[j] - vi;
+          // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one
+          // setting works for any particle count: d_c(paper) = d_c mu / W(h, 0).
+          const double muw = mi * mj / (mi + mj) * (w * inv_w0);
+          const double vn = vab.dot(dh);
+          if (vn * xab.dot(dh) < 0) f += p.collision_damping * muw * vn * dh;  // (3.17)
+          f += p.friction_damping * muw * (vab - vn * dh);  // (3.18) d_f W (v_ij . d^_t) d^_t
+        }
+        ws.pair_f[e] = f;
+      }
+    });
+  }
+  // Gather per particle in a fixed order (adjacency, then neighbour list): deterministic for
+  // any thread count, and each pair's two contributions are exact negations.
   parallel_for(ctx, 0, n, [&](std::size_t i) {
     Vec3 f = Vec3::Zero();
     for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
       const uint32_t q = m.adj_pairs[e];
-      const Vec3 fa = spring_force_on_a(m, m_params, s, ws, q);
-      f += m.pair_a[q] == i ? fa : Vec3(-fa);
+      if (m.pair_a[q] == i)
+        f += ws.spring_f[q];
+      else
+        f -= ws.spring_f[q];
     }
-    if (hh) {
+    if (hh)
       for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-        const uint32_t j = ws.nbrs[e];
-        if (i < j)
-          f += hair_force_on_a(m, m_params, s, ws, uint32_t(i), j);
+        if (ws.nbrs[e] > i)
+          f += ws.pair_f[e];
         else
-          f -= hair_force_on_a(m, m_params, s, ws, j, uint32_t(i));
+          f -= ws.pair_f[ws.nbr_mirror[e]];
       }
-    }
     ws.force[i] = f;
   });
 }
@@ -651,7 +743,7 @@ void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWork
       if (r <= 0) continue;
       const Vec3 xh = d / r;                              // x^_ij
       const double c0 = is_a ? m.cos_a[q] : -m.cos_b[q];  // cos theta0_ij against x_ij
-      const double s0 = std::sqrt(std::max(0.0, 1 - c0 * c0));
+      const double s0 = is_a ? m_sin_a[q] : m_sin_b[q];   // sin theta0_ij
       Vec3 perp = ti - ti.dot(xh) * xh;
       const double pn = perp.norm();
       // t_i^j: x^_ij rotated by theta0_ij about the axis normal to t_i and x_ij (Fig. 3.3 c).
@@ -686,8 +778,10 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
   // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
   int nsub = m_params.substeps;
+  bool alpha_fresh = false;  // ws.k/ws.alpha already hold the values for the current positions
   if (m_params.cfl > 0) {
     solve_alpha(ctx, s, ws);
+    alpha_fresh = true;
     const double w2 = deterministic_reduce(
         ctx, n, 1024, 0.0,
         [&](std::size_t i0, std::size_t i1) {
@@ -718,19 +812,26 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
              al_h = Rt * hd.angular_acceleration, V_h = Rt * hd.velocity;
   const Vec3 piv = hd.pivot;
   ws.accel.resize(n);
-  std::vector<uint8_t> contact(n, 0);
-  std::vector<double> pen(n, 0.0);
+  ws.contact.assign(n, 0);
+  ws.penetration.assign(n, 0.0);
   for (int sub = 0; sub < nsub; ++sub) {
     if (m_params.hair_hair) {
       neighbours_and_density(ctx, s, ws);
     } else {
       ws.nbr_offsets.clear();
     }
-    solve_alpha(ctx, s, ws);
-    pair_forces(ctx, s, ws);
+    if (!alpha_fresh) solve_alpha(ctx, s, ws);
+    alpha_fresh = false;
+    pair_forces_sorted(ctx, s, ws);
+    // Accelerations and the leapfrog update in one pass (each particle reads only its own state):
+    // v(t + dt/2) = v(t - dt/2) + a(t) dt, x(t + dt) = x(t) + v(t + dt/2) dt.
     parallel_for(ctx, 0, n, [&](std::size_t i) {
       if (m.root[i]) {
         ws.accel[i] = Vec3::Zero();
+        ws.contact[i] = 0;
+        ws.penetration[i] = 0;
+        s.x[i] = m.rest_x[i];
+        s.v[i] = Vec3::Zero();
         return;
       }
       const double mi = m.mass[i];
@@ -751,18 +852,10 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
           pdepth = std::max(0.0, -(s.x[i] - pl->p).dot(pl->n));
         }
       }
-      contact[i] = c;
-      pen[i] = pdepth;
+      ws.contact[i] = c;
+      ws.penetration[i] = pdepth;
       ws.accel[i] = a;
-    });
-    // Leapfrog: v(t + dt/2) = v(t - dt/2) + a(t) dt, x(t + dt) = x(t) + v(t + dt/2) dt.
-    parallel_for(ctx, 0, n, [&](std::size_t i) {
-      if (m.root[i]) {
-        s.x[i] = m.rest_x[i];
-        s.v[i] = Vec3::Zero();
-        return;
-      }
-      s.v[i] += ws.accel[i] * dt;
+      s.v[i] += a * dt;
       s.x[i] += s.v[i] * dt;
     });
     update_directions(ctx, s, ws);
@@ -806,8 +899,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       return rep;
     }
   }
-  rep.num_contacts = std::size_t(std::count(contact.begin(), contact.end(), uint8_t(1)));
-  for (double d : pen) rep.max_penetration = std::max(rep.max_penetration, d);
+  rep.num_contacts = std::size_t(std::count(ws.contact.begin(), ws.contact.end(), uint8_t(1)));
+  for (double d : ws.penetration) rep.max_penetration = std::max(rep.max_penetration, d);
   return rep;
 }
 

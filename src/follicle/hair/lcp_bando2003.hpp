@@ -81,6 +81,11 @@ struct LcpParams {
   bool body_collision = true;      // §3.5 on/off (needs voxel planes)
   sim::BodyContactParams contact;  // (3.19)-(3.24)
   double max_speed = 30;           // [m/s] a faster particle is reported as a blow-up
+  // Verlet skin of the hair-hair neighbour lists, as a fraction of the interaction radius 2h:
+  // lists hold all pairs within 2h (1 + skin) and are rebuilt only when some particle has moved
+  // more than half the skin since the last build (0 = rebuild every sub-step). Does not change
+  // which pairs interact (the kernel is zero beyond 2h), only how often the grid is searched.
+  double neighbour_skin = 0.15;
   template <class V>
   void visit(V&& v) {
     v("substeps", substeps, ParamInfo{"minimum sub-steps per step", "", 1, 10000});
@@ -102,6 +107,8 @@ struct LcpParams {
     v("body_collision", body_collision, ParamInfo{"hair-body collision"});
     v("contact", contact);
     v("max_speed", max_speed, ParamInfo{"blow-up speed", "m/s", 1e-3, 1e9});
+    v("neighbour_skin", neighbour_skin,
+      ParamInfo{"Verlet skin / 2h of the neighbour lists", "", 0, 2});
   }
   void validate() const;
 };
@@ -154,13 +161,27 @@ struct LcpStepInput {
 /// Scratch buffers of a solver (reused between steps; not part of the physical state).
 struct LcpWorkspace {
   ParticleGrid grid;
-  std::vector<uint32_t> nbr_offsets, nbrs;  // current neighbours within 2h
-  std::vector<double> density, pressure;    // (3.1), P = k_a (rho - rho0)
-  std::vector<double> k;                    // k_ij (3.7) per connection
-  std::vector<double> alpha;                // alpha_ij (3.14) per connection
-  std::vector<double> alpha_r, alpha_t;     // (3.13) per particle
-  std::vector<Vec3> force;                  // [N] head frame
+  // Neighbours within 2h (1 + skin) at the last build, each list sorted by index (a superset of
+  // the current neighbours within 2h; farther pairs contribute nothing). step() keeps them
+  // between sub-steps (Verlet lists); pair_forces() also accepts lists built by the caller.
+  std::vector<uint32_t> nbr_offsets, nbrs;
+  std::vector<double> density, pressure;  // (3.1), P = k_a (rho - rho0)
+  std::vector<double> k;                  // k_ij (3.7) per connection
+  std::vector<double> alpha;              // alpha_ij (3.14) per connection
+  std::vector<double> alpha_r, alpha_t;   // (3.13) per particle
+  std::vector<Vec3> force;                // [N] head frame
   std::vector<Vec3> accel;
+  // Verlet-list bookkeeping and per-pair scratch (pairs evaluated once, gathered per particle).
+  std::vector<uint32_t> nbr_mirror;  // entry (i -> j) -> entry (j -> i)
+  std::vector<Vec3> nbr_built_x;     // positions at the last list build
+  double nbr_radius = 0;             // radius of the last build [m]
+  std::size_t nbr_builds = 0;        // number of list builds (statistics)
+  std::vector<double> pair_w;        // W(h, r) per entry with i < j
+  std::vector<Vec3> pair_f;          // hair-hair force on i per entry with i < j [N]
+  std::vector<Vec3> spring_f;        // spring force on the root-side end per connection [N]
+  std::vector<double> p_rho2;        // P_i / rho_i^2 per particle
+  std::vector<uint8_t> contact;      // per particle, last sub-step
+  std::vector<double> penetration;   // per particle, last sub-step [m]
 };
 
 /// Builds the connections (§3.3.1, (3.5)-(3.6), pruning by a0 and N_n) for given particles.
@@ -223,7 +244,10 @@ class LcpSolver {
 
  private:
   void neighbours_and_density(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  void pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
   LcpParams m_params;
+  std::vector<double> m_ea;              // E A_i per particle ((3.9) with the constant modulus)
+  std::vector<double> m_sin_a, m_sin_b;  // sin theta0 per connection end (for (3.15))
   LcpModel m_model;
   const sim::VoxelPlanes* m_body = nullptr;
   double m_rho0 = 0;

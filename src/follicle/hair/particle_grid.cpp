@@ -1,5 +1,7 @@
 #include "follicle/hair/particle_grid.hpp"
 
+#include <algorithm>
+
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
 
@@ -83,6 +85,38 @@ void ParticleGrid::cross_lists(const Context& ctx, const std::vector<Vec3>& quer
       if ((grid_points[j] - p).squaredNorm() < r2) out.push_back(j);
     });
   });
+}
+
+bool sort_and_mirror(const Context& ctx, const std::vector<uint32_t>& offsets,
+                     std::vector<uint32_t>& nbrs, std::vector<uint32_t>& mirror) {
+  const std::size_t n = offsets.empty() ? 0 : offsets.size() - 1;
+  parallel_for(
+      ctx, 0, n,
+      [&](std::size_t i) { std::sort(nbrs.begin() + offsets[i], nbrs.begin() + offsets[i + 1]); },
+      64);
+  // Visiting i in increasing order consumes the lower-index part of each list j in order, so one
+  // cursor per particle finds every mirror entry in O(entries).
+  mirror.assign(nbrs.size(), 0);
+  std::vector<uint32_t> cursor(offsets.begin(), offsets.end() - (n ? 1 : 0));
+  for (std::size_t i = 0; i < n; ++i)
+    for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
+      const uint32_t j = nbrs[e];
+      if (j <= i) continue;
+      const uint32_t c = j < n ? cursor[j]++ : 0;
+      if (j >= n || c >= offsets[j + 1] || nbrs[c] != i) {
+        mirror.clear();
+        return false;
+      }
+      mirror[e] = c;
+      mirror[c] = e;
+    }
+  // Every lower-index entry must have been matched.
+  for (std::size_t j = 0; j < n; ++j)
+    if (cursor[j] < offsets[j + 1] && nbrs[cursor[j]] < j) {
+      mirror.clear();
+      return false;
+    }
+  return true;
 }
 
 }  // namespace follicle::hair

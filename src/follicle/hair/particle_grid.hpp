@@ -64,4 +64,11 @@ class ParticleGrid {
   std::vector<std::array<int, 3>> m_cell_sorted;  // integer cell of each sorted point
 };
 
+/// Sorts each CSR list by neighbour index and fills mirror[e] with the entry (j -> i) of every
+/// entry e = (i -> j), so a per-pair value computed once at the lower-index end can be gathered
+/// by the other end in a fixed order (deterministic, equal and opposite). The lists must be
+/// symmetric and free of self entries; returns false (mirror cleared) when they are not.
+bool sort_and_mirror(const Context& ctx, const std::vector<uint32_t>& offsets,
+                     std::vector<uint32_t>& nbrs, std::vector<uint32_t>& mirror);
+
 }  // namespace follicle::hair

@@ -121,16 +121,29 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
       m_rho[i] = rho;
       m_pr[i] = m_p.k_p * std::max(rho - m_rho0, 0.0);
     });
-    // Air-hair neighbour lists, both ways (the same pair term, so forces are equal and opposite).
-    if (nh) {
-      m_hair_grid.cross_lists(ctx, m_x, hair_x, rc, m_aoff, m_anb);  // air -> hair
-      m_grid.cross_lists(ctx, hair_x, m_x, rc, m_hoff, m_hnb);       // hair -> air
-    }
     auto drag_on_hair = [&](std::size_t hi, std::size_t ai) -> Vec3 {
       const double r = (m_x[ai] - hair_x[hi]).norm();
       const double mu = hair_mass[hi] * m_mass / (hair_mass[hi] + m_mass);
       return m_p.drag * mu * (sph_w(rc / 2, r) / wc0) * (m_v[ai] - hair_v[hi]);
     };
+    // Air-hair pairs: lists from each air particle to the hair within rc; the drag of each pair
+    // is evaluated once (force on the hair particle, the air particle gets the negation) and
+    // gathered by the hair particles through the transposed lists, in air-index order
+    // (deterministic; equal and opposite by construction).
+    if (nh) {
+      m_hair_grid.cross_lists(ctx, m_x, hair_x, rc, m_aoff, m_anb);  // air -> hair
+      m_drag.resize(m_anb.size());
+      parallel_for(ctx, 0, n, [&](std::size_t i) {
+        for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) m_drag[e] = drag_on_hair(m_anb[e], i);
+      });
+      // Transpose: hair particle -> its entries e of the air lists.
+      m_hoff.assign(nh + 1, 0);
+      for (uint32_t hi : m_anb) ++m_hoff[hi + 1];
+      for (std::size_t k = 0; k < nh; ++k) m_hoff[k + 1] += m_hoff[k];
+      m_hnb.resize(m_anb.size());
+      m_fill.assign(m_hoff.begin(), m_hoff.end() - 1);
+      for (uint32_t e = 0; e < uint32_t(m_anb.size()); ++e) m_hnb[m_fill[m_anb[e]]++] = e;
+    }
     m_acc.resize(n);
     parallel_for(ctx, 0, n, [&](std::size_t i) {
       Vec3 f = Vec3::Zero();
@@ -144,13 +157,13 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
         f += m_mass * m_mass * (pi + m_pr[j] / (m_rho[j] * m_rho[j])) * sph_dw(h, r) * d / r;
       }
       if (nh)
-        for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) f -= drag_on_hair(m_anb[e], i);
+        for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) f -= m_drag[e];
       m_acc[i] = f / m_mass;
     });
     if (nh)
       parallel_for(ctx, 0, nh, [&](std::size_t hi) {
         Vec3 f = Vec3::Zero();
-        for (uint32_t e = m_hoff[hi]; e < m_hoff[hi + 1]; ++e) f += drag_on_hair(hi, m_hnb[e]);
+        for (uint32_t e = m_hoff[hi]; e < m_hoff[hi + 1]; ++e) f += m_drag[m_hnb[e]];
         impulse[hi] += f * sub;
       });
     parallel_for(ctx, 0, n, [&](std::size_t i) {

@@ -91,6 +91,25 @@ void Scene::validate(const JsonSource& src) const {
         json_fail(src, index_path("animation.head_motion.keys", k) + ".t",
                   "key times must increase strictly");
   }
+  if (hand) {
+    try {
+      hand->validate();
+    } catch (const Error& e) {
+      json_fail(src, "hand", e.what());
+    }
+  }
+  if (lcp) {
+    try {
+      lcp->validate();
+    } catch (const Error& e) {
+      json_fail(src, "lcp", e.what());
+    }
+  }
+  {  // skin_section.cpp
+    std::vector<std::string> mesh_names;
+    for (const auto& m : assets.meshes) mesh_names.push_back(m.name);
+    validate_skin_section(skin, mesh_names, animation.has_value(), src);
+  }
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const auto& o = outputs[i];
     const std::string p = index_path("outputs", i) + ".path";

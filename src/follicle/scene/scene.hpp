@@ -18,7 +18,9 @@
 #include "follicle/core/types.hpp"
 #include "follicle/core/units.hpp"
 #include "follicle/scene/hair_section.hpp"
+#include "follicle/scene/hand_section.hpp"
 #include "follicle/scene/json_params.hpp"
+#include "follicle/scene/skin_section.hpp"
 
 namespace follicle::scene {
 
@@ -186,6 +188,9 @@ struct Scene {
   std::vector<OutputSpec> outputs;
   std::vector<HairGroupSpec> hair;
   std::optional<AnimationSpec> animation;
+  std::vector<SkinSpec> skin;  // skin_section.hpp
+  std::optional<HandSpec> hand;
+  std::optional<LcpSpec> lcp;
 
   template <class V>
   void visit(V&& v) {
@@ -200,6 +205,11 @@ struct Scene {
     v("hair", hair, ParamInfo{"hair groups grown on mesh assets (Anjyo 1992)"});
     v("animation", animation,
       ParamInfo{"frame rate, clip length, head motion and wind (absent: a still scene)"});
+    v("skin", skin,
+      ParamInfo{"face rigs on mesh assets: muscles, tissue, wrinkles, skin colour (Bando 2002)"});
+    v("hand", hand,
+      ParamInfo{"skeleton-animated MakeHuman hand with joint and fine wrinkles (Bando 2002 §2.7)"});
+    v("lcp", lcp, ParamInfo{"loosely connected particle hair (Bando 2003 ch. 3)"});
   }
 
   /// Cross-field checks the per-key ranges cannot express (near < far, eye != target, unique

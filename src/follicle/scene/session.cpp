@@ -60,6 +60,10 @@ void Session::validate() const {
         json_fail(src, p + ".material.texture", "texture file not found: " + tex.string());
     }
   }
+  if (m_scene.hand && !std::filesystem::is_directory(resolve(m_scene.hand->makehuman)))
+    json_fail(src, "hand.makehuman",
+              "MakeHuman folder not found: " + resolve(m_scene.hand->makehuman).string());
+  validate_skin_files();  // session_skin.cpp
 }
 
 std::filesystem::path Session::resolve(const std::string& relative) const {
@@ -109,6 +113,7 @@ void Session::load_all_assets() {
     if (!m_scene.assets.meshes[i].material.texture.empty())
       texture(m_scene.assets.meshes[i].material.texture);
   }
+  load_skin_setups();  // session_skin.cpp
 }
 
 render::RenderScene Session::render_scene(int frame) {
@@ -151,6 +156,7 @@ render::RenderScene Session::render_scene(int frame) {
     mat.shininess = a.material.shininess;
     mat.ambient = a.material.ambient;
     if (!a.material.texture.empty()) mat.albedo_map = texture(a.material.texture);
+    apply_skin(i, item, frame);  // face rig (session_skin.cpp)
     rs.meshes.push_back(std::move(item));
   }
   // Hair: Anjyo 1992 §4 shading per node (eqs. 8, 9; k_a per strand) on the CPU, drawn as
@@ -170,6 +176,8 @@ render::RenderScene Session::render_scene(int frame) {
     item.cast_shadow = false;  // 1-px lines make a speckled shadow map; the paper has no shadows
     rs.strands.push_back(std::move(item));
   }
+  add_hand_items(rs, frame);  // session_hand.cpp
+  add_lcp_items(rs, frame);   // session_lcp.cpp
   return rs;
 }
 
@@ -206,6 +214,17 @@ std::string Session::summary() const {
         "hair: {} on mesh \"{}\", style {}, density scale {}\n", h.name, h.mesh,
         h.style.custom ? "\"" + h.style.custom->name + "\" (custom)" : "\"" + h.style.preset + "\"",
         h.density_scale);
+  if (m_scene.hand)
+    out += fmt::format("hand: MakeHuman ({}), wrinkles {}, flexion {}\n", m_scene.hand->makehuman,
+                       m_scene.hand->wrinkles ? "on" : "off",
+                       m_scene.hand->flexion ? fmt::format("{}", *m_scene.hand->flexion)
+                                             : std::string("from the flexion track"));
+  if (m_scene.lcp)
+    out += fmt::format("lcp hair: spacing {} m, hair-hair {}{}{}{}\n", m_scene.lcp->scenario.spacing,
+                       m_scene.lcp->dynamics.hair_hair ? "on" : "off",
+                       m_scene.lcp->scenario.shake ? ", head shake" : "",
+                       m_scene.lcp->scenario.wind ? ", SPH wind" : "",
+                       m_scene.lcp->part ? ", parting force" : "");
   if (m_scene.animation)
     out += fmt::format("animation: {} frames at {} fps\n", m_scene.animation->frame_count(),
                        m_scene.animation->fps);

@@ -14,10 +14,15 @@
 #include "follicle/image/image.hpp"
 #include "follicle/render/render_scene.hpp"
 #include "follicle/scene/scene.hpp"
+#include "follicle/skin/hand_rig.hpp"
+#include "follicle/skin/face_rig.hpp"
 
 namespace follicle::scene {
 
 class HairRuntime;  // session_hair.cpp
+class HandRuntime;  // session_hand.cpp
+class LcpRuntime;   // session_lcp.cpp
+class SkinRuntime;  // session_skin.cpp
 
 /// Counters of the hair pipeline (tests check that cached frames are not re-simulated).
 struct HairStats {
@@ -85,6 +90,35 @@ class Session {
   /// The rigid head-motion transform at `frame` (rest -> current), none for a still head.
   std::optional<Affine3> head_motion_transform(int frame);
 
+  /// The hand ("hand" section) at `frame`: skinned mesh with joint wrinkles and the modulated
+  /// fine relief [m] (no relief when hand.wrinkles is false). Throws when there is no hand.
+  skin::HandFrame hand_frame(int frame);
+  /// Finger flexion in [0, 1] of the hand at `frame`.
+  double hand_flexion(int frame) const;
+  /// Writes the fine-wrinkle relief of the hand as height, normal and displacement maps (float
+  /// EXR + 8-bit PNG, skin::export_wrinkle_maps) into `dir`: the rest state when frame < 0
+  /// (stem "hand_rest"), else the modulated relief at that frame (stem "hand_frame_NNNN").
+  /// Returns the stem written. Throws when the scene has no fine-wrinkle source.
+  std::string export_wrinkle_maps(const std::filesystem::path& dir, int frame);
+  /// LCP hair particles ("lcp" section) in the world frame with directions t_i at `frame`,
+  /// simulated deterministically from frame 0 (consecutive frames continue from the kept state).
+  /// Throws when there is no lcp section or the simulation blows up.
+  std::shared_ptr<const geom::ParticleSet> lcp_particles(int frame);
+  /// Simulation steps taken by the LCP hair so far (tests check consecutive frames continue).
+  std::size_t lcp_steps() const;
+
+  /// Face rigs ("skin" section, session_skin.cpp). The rig of skin[rig] (built on first use).
+  const skin::FaceRig& face_rig(std::size_t rig);
+  /// The muscle pose of skin[rig] at `frame`: its expression, or its contraction track sampled.
+  skin::MusclePose skin_pose(std::size_t rig, int frame);
+  /// The deformed, wrinkled mesh of skin[rig] at `frame` (mesh-file coordinates in metres, the
+  /// asset transform NOT applied; normals of the deformed surface). Cached per frame.
+  std::shared_ptr<const geom::TriMesh> skin_mesh(std::size_t rig, int frame);
+  /// Index into scene().skin of the rig on mesh asset `asset`, if any.
+  std::optional<std::size_t> skin_rig_of_mesh(std::size_t asset) const;
+  /// Loads every face-setup file and checks the skin section against it (for validate).
+  void load_skin_setups();
+
   /// A few lines describing the scene (for `follicle info`).
   std::string summary() const;
 
@@ -97,6 +131,15 @@ class Session {
   std::map<std::string, std::shared_ptr<const image::ImageRGBA8>> m_textures;
   std::unique_ptr<HairRuntime> m_hair;
   HairRuntime& hair_runtime();
+  std::shared_ptr<HandRuntime> m_hand;  // shared_ptr: incomplete type here
+  std::shared_ptr<LcpRuntime> m_lcp;
+  void add_hand_items(render::RenderScene& rs, int frame);
+  void add_lcp_items(render::RenderScene& rs, int frame);
+  std::shared_ptr<SkinRuntime> m_skin;  // session_skin.cpp
+  SkinRuntime& skin_runtime();
+  void resolve_skin(std::size_t rig);
+  void validate_skin_files() const;
+  void apply_skin(std::size_t asset, render::MeshItem& item, int frame);
 };
 
 }  // namespace follicle::scene

@@ -2,8 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <map>
+#include <memory>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -67,8 +73,40 @@ double segment_hit(const Vec2& p, const Vec2& q, const Vec2& a, const Vec2& b) {
   return t;
 }
 
+/// A working image of n values in 2 MiB pages where the kernel allows it (madvise): the furrow
+/// walk reads and writes the 2048^2 images at scattered places, and with 4 KiB pages nearly
+/// every texel row it touches was a TLB miss.
+template <class T>
+class BigBuffer {
+ public:
+  BigBuffer(std::size_t n, T fill) : m_n(n) {
+    constexpr std::size_t kHuge = std::size_t(2) << 20;
+    const std::size_t bytes = std::max<std::size_t>(kHuge, (n * sizeof(T) + kHuge - 1) / kHuge * kHuge);
+    m_p.reset(static_cast<T*>(std::aligned_alloc(kHuge, bytes)));
+    if (!m_p) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    madvise(m_p.get(), bytes, MADV_HUGEPAGE);  // a hint; failure only costs speed
+#endif
+    std::fill(m_p.get(), m_p.get() + n, fill);
+  }
+  T* data() { return m_p.get(); }
+  const T* data() const { return m_p.get(); }
+  std::size_t size() const { return m_n; }
+  T& operator[](std::size_t i) { return m_p.get()[i]; }
+  const T& operator[](std::size_t i) const { return m_p.get()[i]; }
+
+ private:
+  struct Free {
+    void operator()(T* p) const { std::free(p); }
+  };
+  std::unique_ptr<T, Free> m_p;
+  std::size_t m_n;
+};
+
 /// Uniform grid of furrow segments in texel space for step 4's intersection test. Hand-written
-/// (a tiny structure; geom's Embree BVH would have to be rebuilt after every segment).
+/// (a tiny structure; geom's Embree BVH would have to be rebuilt after every segment). Each cell
+/// keeps its own copy of the segments that touch it (no indirection: the lookups were cache
+/// misses); a segment met in two cells is simply tested twice, which leaves the minimum alone.
 class SegmentGrid {
  public:
   SegmentGrid(int size, double cell) : m_cell(cell) {
@@ -76,23 +114,15 @@ class SegmentGrid {
     m_cells.resize(std::size_t(m_n) * m_n);
   }
   void add(const Vec2& a, const Vec2& b, int furrow) {
-    const int id = int(m_a.size());
-    m_a.push_back(a);
-    m_b.push_back(b);
-    m_furrow.push_back(furrow);
-    visit_cells(a, b, [&](std::vector<int>& c) { c.push_back(id); });
+    visit_cells(a, b, [&](std::vector<Seg>& c) { c.push_back({a, b, furrow}); });
   }
   /// Closest crossing of p->q with a segment of another furrow: t in (0, 1], or -1.
   double closest_hit(const Vec2& p, const Vec2& q, int furrow) {
     double best = -1;
-    ++m_stamp;
-    visit_cells(p, q, [&](std::vector<int>& c) {
-      for (int id : c) {
-        if (m_furrow[id] == furrow) continue;
-        if (m_seen.size() <= std::size_t(id)) m_seen.resize(m_a.size(), 0);
-        if (m_seen[id] == m_stamp) continue;
-        m_seen[id] = m_stamp;
-        const double t = segment_hit(p, q, m_a[id], m_b[id]);
+    visit_cells(p, q, [&](std::vector<Seg>& c) {
+      for (const Seg& sg : c) {
+        if (sg.furrow == furrow) continue;
+        const double t = segment_hit(p, q, sg.a, sg.b);
         if (t > 0 && (best < 0 || t < best)) best = t;
       }
     });
@@ -100,6 +130,10 @@ class SegmentGrid {
   }
 
  private:
+  struct Seg {
+    Vec2 a, b;
+    int furrow;
+  };
   template <class F>
   void visit_cells(const Vec2& a, const Vec2& b, F&& f) {
     const int x0 = clampi(int(std::floor(std::min(a.x(), b.x()) / m_cell)));
@@ -112,12 +146,119 @@ class SegmentGrid {
   int clampi(int i) const { return std::clamp(i, 0, m_n - 1); }
   double m_cell;
   int m_n = 1;
-  std::vector<std::vector<int>> m_cells;
-  std::vector<Vec2> m_a, m_b;
-  std::vector<int> m_furrow;
-  std::vector<uint32_t> m_seen;
-  uint32_t m_stamp = 0;
+  std::vector<std::vector<Seg>> m_cells;
 };
+
+/// The texels of image::draw_line(img, a, b, width, ...) with their coverage: calls
+/// f(texel index, cov) for every texel with cov > 0, with the same distance and coverage
+/// arithmetic as image/raster.cpp, so blending gives the same values texel for texel. Visits in
+/// each row only the texels that can be covered instead of draw_line's whole bounding box, and
+/// does not allocate. Hand-written: carving draws two segments per furrow step, which made
+/// draw_line the hot spot of §2.6.2. Returns false (nothing visited) for non-finite input.
+template <class F>
+bool visit_segment(int w, int h, const Vec2& a, const Vec2& b, double width, const float* img,
+                   F&& f) {
+  const double r = 0.5 * width;
+  if (!a.allFinite() || !b.allFinite() || !std::isfinite(r) || r < 0) return false;
+  // draw_polyline's box (r + 1 around the segment).
+  const int bx0 = std::max(0, int(std::floor(std::min(a.x(), b.x()) - r - 1)));
+  const int by0 = std::max(0, int(std::floor(std::min(a.y(), b.y()) - r - 1)));
+  const int bx1 = std::min(w - 1, int(std::ceil(std::max(a.x(), b.x()) + r + 1)));
+  const int by1 = std::min(h - 1, int(std::ceil(std::max(a.y(), b.y()) + r + 1)));
+  if (bx0 > bx1 || by0 > by1) return true;
+  const Vec2 ab = b - a;
+  const double l2 = ab.squaredNorm();
+  // Coverage needs d < r + 0.5; rows and columns are bounded with one more texel of margin.
+  const double R = r + 1.5;
+  for (int y = by0; y <= by1; ++y) {
+    const double yc = y + 0.5;
+    // x extent of the part of the segment within R of the row's centre line.
+    double lo, hi;
+    if (ab.y() == 0.0) {
+      if (std::abs(a.y() - yc) > R) continue;
+      lo = std::min(a.x(), b.x());
+      hi = std::max(a.x(), b.x());
+    } else {
+      const double ta = (yc - R - a.y()) / ab.y(), tb = (yc + R - a.y()) / ab.y();
+      const double t0 = std::max(0.0, std::min(ta, tb)), t1 = std::min(1.0, std::max(ta, tb));
+      if (t0 > t1) continue;
+      const double xa = a.x() + t0 * ab.x(), xb = a.x() + t1 * ab.x();
+      lo = std::min(xa, xb);
+      hi = std::max(xa, xb);
+    }
+    const int x0 = std::max(bx0, int(std::floor(lo - R)) - 1);
+    const int x1 = std::min(bx1, int(std::ceil(hi + R)) + 1);
+    const std::size_t rowi = std::size_t(y) * std::size_t(w);
+    if (y + 2 <= by1) {  // the rows are cache misses: start loading two rows ahead
+      __builtin_prefetch(img + rowi + 2 * std::size_t(w) + x0);
+      __builtin_prefetch(img + rowi + 2 * std::size_t(w) + x1);
+    }
+    for (int x = x0; x <= x1; ++x) {
+      // image/raster.cpp seg_dist and coverage, the same expressions.
+      const Vec2 p(x + 0.5, yc);
+      double t = l2 > 0 ? (p - a).dot(ab) / l2 : 0.0;
+      t = std::clamp(t, 0.0, 1.0);
+      const double d = (p - (a + t * ab)).norm();
+      const double cov = std::clamp(0.5 + r - d, 0.0, 1.0);
+      if (cov > 0) f(rowi + std::size_t(x), cov);
+    }
+  }
+  return true;
+}
+
+/// Occupancy (§2.6.2 step 6): sets occ[i] = 1 where image::draw_line(.., width, 1.0f,
+/// Blend::Max) would write a coverage float(cov) >= 0.5. Texels clearly inside (d <= r - 1e-6)
+/// or outside (d >= r + 1e-6) are decided from the squared distance; the ones in between by
+/// the exact coverage expression, so the result is the same texel for texel.
+void mark_segment(int n, const Vec2& a, const Vec2& b, double width, uint8_t* occ) {
+  const double r = 0.5 * width, m = 1e-6;
+  if (!a.allFinite() || !b.allFinite() || !std::isfinite(r) || r < 0) return;
+  const double in2 = r > m ? (r - m) * (r - m) : -1.0, out2 = (r + m) * (r + m);
+  const int bx0 = std::max(0, int(std::floor(std::min(a.x(), b.x()) - r - 1)));
+  const int by0 = std::max(0, int(std::floor(std::min(a.y(), b.y()) - r - 1)));
+  const int bx1 = std::min(n - 1, int(std::ceil(std::max(a.x(), b.x()) + r + 1)));
+  const int by1 = std::min(n - 1, int(std::ceil(std::max(a.y(), b.y()) + r + 1)));
+  if (bx0 > bx1 || by0 > by1) return;
+  const Vec2 ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double R = r + 1.5;
+  for (int y = by0; y <= by1; ++y) {
+    const double yc = y + 0.5;
+    double lo, hi;
+    if (ab.y() == 0.0) {
+      if (std::abs(a.y() - yc) > R) continue;
+      lo = std::min(a.x(), b.x());
+      hi = std::max(a.x(), b.x());
+    } else {
+      const double ta = (yc - R - a.y()) / ab.y(), tb = (yc + R - a.y()) / ab.y();
+      const double t0 = std::max(0.0, std::min(ta, tb)), t1 = std::min(1.0, std::max(ta, tb));
+      if (t0 > t1) continue;
+      const double xa = a.x() + t0 * ab.x(), xb = a.x() + t1 * ab.x();
+      lo = std::min(xa, xb);
+      hi = std::max(xa, xb);
+    }
+    const int x0 = std::max(bx0, int(std::floor(lo - R)) - 1);
+    const int x1 = std::min(bx1, int(std::ceil(hi + R)) + 1);
+    uint8_t* row = occ + std::size_t(y) * std::size_t(n);
+    if (y + 2 <= by1) {  // the rows are cache misses: start loading two rows ahead
+      __builtin_prefetch(row + 2 * std::size_t(n) + x0);
+      __builtin_prefetch(row + 2 * std::size_t(n) + x1);
+    }
+    for (int x = x0; x <= x1; ++x) {
+      if (row[x]) continue;
+      const Vec2 p(x + 0.5, yc);
+      double t = l2 > 0 ? (p - a).dot(ab) / l2 : 0.0;
+      t = std::clamp(t, 0.0, 1.0);
+      const double d2 = (p - (a + t * ab)).squaredNorm();
+      if (d2 <= in2) {
+        row[x] = 1;
+      } else if (d2 < out2) {
+        const double cov = std::clamp(0.5 + r - std::sqrt(d2), 0.0, 1.0);  // raster.cpp's
+        if (float(cov) * 1.0f >= 0.5f) row[x] = 1;
+      }
+    }
+  }
+}
 
 }  // namespace
 
@@ -266,19 +407,24 @@ class Carver {
         m_seed(seed),
         m_out(out),
         m_init(init),
-        m_grid(tm.size, std::max(8.0, std::ceil(6.0 * unit))) {
+        m_grid(tm.size, std::max(8.0, std::ceil(6.0 * unit))),
+        m_h(std::size_t(tm.size) * tm.size, 1.0f),
+        m_occ(std::size_t(tm.size) * tm.size, 1) {
     const int n = tm.size;
-    out.height.resize(n, n, 1.0f);     // initialized in white
-    out.occupancy.resize(n, n, 1.0f);  // 1 (forbidden) where the mesh is not mapped
-    for (uint32_t i : tm.covered) out.occupancy.data()[i] = 0.0f;
+    out.height.resize(n, n, 1.0f);  // initialized in white (carved in m_h, copied at the end)
+    // The occupancy image is only ever compared with 0.5 (and binarized at the end), and
+    // max(old, c) >= 0.5 iff old >= 0.5 or c >= 0.5: it is kept as one byte per texel (a quarter
+    // of the memory traffic of the float image), 1 = occupied.
+    // 1 (forbidden) where the mesh is not mapped
+    for (uint32_t i : tm.covered) m_occ[i] = 0;
     if (init) {
       const std::size_t np = std::size_t(n) * n;
       if (init->locked.size() != np || init->height.width() != n)
         fail("seam init does not match the texture resolution {}", n);
       for (std::size_t i = 0; i < np; ++i)
         if (init->locked[i]) {
-          out.height.data()[i] = init->height.data()[i];
-          out.occupancy.data()[i] = 1.0f;
+          m_h[i] = init->height.data()[i];
+          m_occ[i] = 1;
         }
       const Polylines& pl = init->furrows;
       for (std::size_t k = 0; k < pl.size(); ++k)
@@ -308,7 +454,14 @@ class Carver {
   bool occupied(const Vec2& P) const {
     const int x = int(std::floor(P.x())), y = int(std::floor(P.y()));
     if (!m_tm.inside(x, y)) return true;
-    return m_out.occupancy.at(x, y) >= 0.5f;
+    return m_occ[std::size_t(y) * m_tm.size + x] != 0;
+  }
+  /// The carved height image and the binary occupancy image (§2.6.2 steps 5 and 6).
+  void write_images(image::ImageF& height, image::ImageF& img) const {
+    std::memcpy(height.data(), m_h.data(), m_h.size() * sizeof(float));
+    img.resize(m_tm.size, m_tm.size, 0.0f);
+    float* o = img.data();
+    for (std::size_t i = 0; i < m_occ.size(); ++i) o[i] = m_occ[i] ? 1.0f : 0.0f;
   }
   bool locked(const Vec2& P) const {
     if (!m_init) return false;
@@ -345,9 +498,19 @@ class Carver {
         }
         if (locked(Q)) n = 0;  // seam strip: copied from the neighbour, do not grow into it
         // step 5: carve PQ on the height image with intensity I and width W_h
-        image::draw_line(m_out.height, P, Q, fp.Wh * m_unit, float(fp.I), image::Blend::Min);
-        // step 6: record PQ on the occupancy image with value 1 and width W_o
-        image::draw_line(m_out.occupancy, P, Q, fp.Wo * m_unit, 1.0f, image::Blend::Max);
+        // (image::draw_line with Blend::Min, texel for texel)
+        const float I = float(fp.I);
+        float* hgt = m_h.data();
+        const int sz = m_tm.size;
+        if (!visit_segment(sz, sz, P, Q, fp.Wh * m_unit, hgt, [&](std::size_t i, double cov) {
+              const float cf = float(cov);
+              hgt[i] = hgt[i] + cf * (std::min(hgt[i], I) - hgt[i]);
+            }))
+          image::draw_line(m_out.height, P, Q, fp.Wh * m_unit, I, image::Blend::Min);  // throws
+                                                                                   // the error
+        // step 6: record PQ on the occupancy image with value 1 and width W_o (Blend::Max of
+        // the coverage; only whether it reaches 0.5 matters, see the constructor)
+        mark_segment(sz, P, Q, fp.Wo * m_unit, m_occ.data());
         m_grid.add(P, Q, id);
         pts.push_back(Q);
         ++m_out.segments;
@@ -374,6 +537,8 @@ class Carver {
   HeightField& m_out;
   const SeamInit* m_init;
   SegmentGrid m_grid;
+  BigBuffer<float> m_h;      // the height image while carving
+  BigBuffer<uint8_t> m_occ;  // occupancy: 1 = occupied (see the constructor)
 };
 
 }  // namespace
@@ -420,7 +585,7 @@ HeightField carve_furrows(const geom::TriMesh& mesh, const TexelMap& texels,
     }
   }
   // Binary occupancy, and the seam strip exactly as copied.
-  for (float& o : out.occupancy.storage()) o = o >= 0.5f ? 1.0f : 0.0f;
+  carver.write_images(out.height, out.occupancy);
   if (init)
     for (std::size_t i = 0; i < init->locked.size(); ++i)
       if (init->locked[i]) out.height.data()[i] = init->height.data()[i];
@@ -605,6 +770,24 @@ FineWrinkleAnimator::FineWrinkleAnimator(const geom::TriMesh& rest, const FineWr
   m_lut.resize(kLutN + 1);
   for (int i = 0; i <= kLutN; ++i)
     m_lut[i] = float(amplitude_modulation(kLutLo + (1.0 - kLutLo) * i / kLutN, m_r));
+  const std::size_t np = std::size_t(m_size) * m_size;
+  m_blank.assign(np, 0.0f);
+  m_act_row.assign(std::size_t(m_size) + 1, 0);
+  for (std::size_t y = 0; y < std::size_t(m_size); ++y) {
+    for (std::size_t i = y * m_size, e = i + m_size; i < e; ++i) {
+      const int f = m_texels.tri[i];
+      if (f < 0) continue;
+      m_blank[i] = -0.0f;  // -(M(sa) * 0 + M(sb) * 0)
+      if (m_depth_img[0][i] == 0.0f && m_depth_img[1][i] == 0.0f) continue;
+      m_act_idx.push_back(uint32_t(i));
+      m_act_face.push_back(f);
+      m_act_b1.push_back(m_texels.b1[i]);
+      m_act_b2.push_back(m_texels.b2[i]);
+      m_act_d0.push_back(m_depth_img[0][i]);
+      m_act_d1.push_back(m_depth_img[1][i]);
+    }
+    m_act_row[y + 1] = uint32_t(m_act_idx.size());
+  }
 }
 
 void FineWrinkleAnimator::shrinkage(const Context& ctx, const std::vector<Vec3>& x,
@@ -654,11 +837,14 @@ void FineWrinkleAnimator::modulate(const Context& ctx, const std::array<std::vec
                                    image::ImageF& relief) const {
   if (relief.width() != m_size || relief.height() != m_size) relief.resize(m_size, m_size, 0.0f);
   float* o = relief.data();
-  const float* d0 = m_depth_img[0].data();
-  const float* d1 = m_depth_img[1].data();
-  const int32_t* tri = m_texels.tri.data();
-  const float* B1 = m_texels.b1.data();
-  const float* B2 = m_texels.b2.data();
+  const uint32_t* row_begin = m_act_row.data();
+  const uint32_t* idx = m_act_idx.data();
+  const int32_t* tri = m_act_face.data();
+  const float* B1 = m_act_b1.data();
+  const float* B2 = m_act_b2.data();
+  const float* d0 = m_act_d0.data();
+  const float* d1 = m_act_d1.data();
+  const float* blank = m_blank.data();
   const float* lut = m_lut.data();
   const float scale = float(kLutN) / (1.0f - kLutLo);
   const double r = m_r;
@@ -674,20 +860,17 @@ void FineWrinkleAnimator::modulate(const Context& ctx, const std::array<std::vec
   const float* s0 = s[0].data();
   const float* s1 = s[1].data();
   const Vec3i* faces = m_uv_faces.data();
+  const std::size_t n = std::size_t(m_size);
   parallel_for(
-      ctx, 0, std::size_t(m_size),
+      ctx, 0, n,
       [&](std::size_t y) {
-        for (std::size_t i = y * m_size, e = i + m_size; i < e; ++i) {
-          const int f = tri[i];
-          if (f < 0) {
-            o[i] = 0.0f;
-            continue;
-          }
-          const Vec3i& T = faces[f];
-          const float b1 = B1[i], b2 = B2[i], b0 = 1.0f - b1 - b2;
+        std::copy(blank + y * n, blank + (y + 1) * n, o + y * n);  // 0 unmapped, -0 no furrow
+        for (uint32_t k = row_begin[y], e = row_begin[y + 1]; k < e; ++k) {
+          const Vec3i& T = faces[tri[k]];
+          const float b1 = B1[k], b2 = B2[k], b0 = 1.0f - b1 - b2;
           const float sa = b0 * s0[T[0]] + b1 * s0[T[1]] + b2 * s0[T[2]];
           const float sb = b0 * s1[T[0]] + b1 * s1[T[1]] + b2 * s1[T[2]];
-          o[i] = -(M(sa) * d0[i] + M(sb) * d1[i]);  // (2.4) per field, superimposed
+          o[idx[k]] = -(M(sa) * d0[k] + M(sb) * d1[k]);  // (2.4) per field, superimposed
         }
       },
       8);

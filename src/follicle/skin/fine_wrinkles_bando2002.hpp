@@ -181,6 +181,13 @@ class FineWrinkleAnimator {
   TexelMap m_texels;
   std::array<std::vector<float>, 2> m_depth_img;  // 1 - h_k per texel
   std::vector<float> m_lut;                       // M(s) on [kLutLo, 1]
+  // modulate(): the relief of texels without any furrow depth is -0 (0 where unmapped) for every
+  // s, so it is copied from m_blank; only the texels with depth in some field ("active", in
+  // raster order, rows m_act_row[y] .. m_act_row[y+1]) are computed.
+  std::vector<float> m_blank;
+  std::vector<uint32_t> m_act_row, m_act_idx;
+  std::vector<int32_t> m_act_face;
+  std::vector<float> m_act_b1, m_act_b2, m_act_d0, m_act_d1;
 };
 
 }  // namespace follicle::skin

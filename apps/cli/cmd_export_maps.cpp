@@ -1,0 +1,81 @@
+// follicle export SCENE --maps DIR [--frames A-B]: the fine-wrinkle relief of the scene's hand
+// as height, normal and displacement maps (float EXR + 8-bit PNG, skin::export_wrinkle_maps) for
+// the rest state (DIR/hand_rest_*) and every frame of the range (DIR/hand_frame_NNNN_*). Every
+// file is written atomically (temp file + rename).
+#include <fmt/format.h>
+
+#include <cctype>
+#include <filesystem>
+
+#include "commands.hpp"
+#include "follicle/core/error.hpp"
+#include "follicle/core/progress.hpp"
+#include "follicle/scene/session.hpp"
+
+namespace follicle::cli {
+
+namespace {
+
+// "A-B" or "A" -> [first, last]; -1 for an absent bound. (Same syntax as animate --frames.)
+void parse_map_frames(const std::string& s, int& first, int& last) {
+  const auto bad = [&] {
+    return UsageError(
+        fmt::format("--frames expects A-B (e.g. 0-47) or one frame number, got '{}'", s));
+  };
+  if (s.empty()) return;
+  const auto dash = s.find('-');
+  auto num = [&](const std::string& t) {
+    if (t.empty() || t.size() > 9) throw bad();
+    for (char c : t)
+      if (!std::isdigit(static_cast<unsigned char>(c))) throw bad();
+    return std::stoi(t);
+  };
+  if (dash == std::string::npos) {
+    first = last = num(s);
+  } else {
+    first = num(s.substr(0, dash));
+    last = num(s.substr(dash + 1));
+  }
+  if (last < first)
+    throw UsageError(fmt::format("--frames {}: the last frame is before the first", s));
+}
+
+}  // namespace
+
+int run_export_maps(const GlobalOptions& g, const ExportArgs& a) {
+  auto ctx = make_context(g);
+  int first = -1, last = -1;
+  parse_map_frames(a.frames, first, last);
+  auto session = scene::Session::load(a.scene, *ctx);
+  if (!session.scene().hand)
+    fail_at(a.scene,
+            "the scene has no fine-wrinkle source for --maps (a \"hand\" section); nothing to "
+            "export");
+  const int count = session.frame_count();
+  if (first < 0) {
+    first = 0;
+    last = count - 1;
+  }
+  if (last >= count)
+    throw UsageError(
+        fmt::format("--frames {}-{}: the scene has frames 0-{}", first, last, count - 1));
+  const std::filesystem::path dir(a.maps);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) fail_at(dir.string(), "cannot create the maps folder: {}", ec.message());
+  Progress progress("maps", std::size_t(last - first + 2), !g.quiet);
+  session.export_wrinkle_maps(dir, -1);  // rest state
+  progress.tick();
+  for (int f = first; f <= last; ++f) {
+    session.export_wrinkle_maps(dir, f);
+    progress.tick();
+  }
+  progress.finish();
+  if (!g.quiet)
+    fmt::print("wrote height, normal and displacement maps (EXR + PNG) of the rest state and "
+               "frames {}-{} to {}\n",
+               first, last, dir.string());
+  return 0;
+}
+
+}  // namespace follicle::cli

@@ -1,0 +1,149 @@
+// Session: loosely connected particle hair (Bando, Chen & Nishita 2003; thesis ch. 3) through
+// hair::LcpScenario (back hair on a sphere head, optional head shake and SPH wind). The
+// simulation starts at frame 0 and advances steps_per_frame steps of 1 / (fps steps_per_frame)
+// per frame; consecutive frames continue from the kept state, an earlier frame restarts from
+// frame 0, so any frame is the same whatever was rendered before it. The particles are drawn as
+// hair splats (render::ParticleShading::HairSplat, §3.4) aligned with t_i.
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "follicle/core/error.hpp"
+#include "follicle/core/log.hpp"
+#include "follicle/scene/hand_runtime.hpp"
+#include "follicle/scene/session.hpp"
+
+namespace follicle::scene {
+
+std::size_t Session::lcp_steps() const {
+  return m_lcp ? m_lcp->steps : 0;
+}
+
+std::shared_ptr<const geom::ParticleSet> Session::lcp_particles(int frame) {
+  if (!m_scene.lcp) fail_at(m_source, "the scene has no \"lcp\" section");
+  if (frame < 0) fail("frame {} is negative", frame);
+  const LcpSpec& spec = *m_scene.lcp;
+  if (!m_lcp) m_lcp = std::make_shared<LcpRuntime>();
+  LcpRuntime& rt = *m_lcp;
+  if (rt.last && rt.last_frame == frame) return rt.last;
+  if (!rt.ctx)
+    rt.ctx = std::make_unique<Context>(m_ctx->threads(), spec.seed, m_ctx->logger_ptr());
+  const Context& ctx = *rt.ctx;
+  if (!m_scene.animation && frame > 0)
+    fail_at(m_source, "frame {} of a still scene (add an \"animation\" section)", frame);
+
+  if (!rt.sim || rt.state_frame > frame) {  // (re)start deterministically at frame 0
+    try {
+      rt.sim = std::make_unique<hair::LcpScenario>(ctx, spec.scenario, spec.dynamics);
+    } catch (const Error& e) {
+      fail_at(m_source, "lcp: {}", e.what());
+    }
+    rt.head = std::make_shared<const geom::TriMesh>(rt.sim->head());
+    rt.state_frame = 0;
+    if (spec.part) {
+      // Same body as LcpScenario (voxel planes of the head, voxel >= the particle spacing).
+      sim::VoxelPlanesParams vp;
+      vp.voxel_size = std::max(0.01, spec.scenario.spacing);
+      rt.body = std::make_unique<sim::VoxelPlanes>(sim::VoxelPlanes::build({rt.head.get()}, vp, 3));
+      rt.solver = std::make_unique<hair::LcpSolver>(spec.dynamics, rt.sim->solver().model(),
+                                                    rt.body.get());
+      rt.state = rt.sim->state();
+      rt.ws = std::make_unique<hair::LcpWorkspace>();
+    }
+    ctx.log().info("lcp: {} particles, {} connections", rt.sim->solver().model().size(),
+                   rt.sim->solver().model().num_pairs());
+  }
+  const double dt = m_scene.animation
+                        ? 1.0 / (m_scene.animation->fps * double(spec.steps_per_frame))
+                        : 0.0;
+  while (rt.state_frame < frame) {
+    const int f = rt.state_frame + 1;
+    for (int k = 0; k < spec.steps_per_frame; ++k) {
+      hair::LcpStepReport rep;
+      if (rt.solver) {  // back hair with the parting force (Fig. 3.7)
+        const auto& model = rt.solver->model();
+        const double a = spec.part->at(rt.state.time);
+        rt.force.assign(model.size(), Vec3::Zero());
+        for (std::size_t i = 0; i < model.size(); ++i) {
+          if (model.root[i]) continue;
+          const double side = rt.state.x[i].x() >= spec.part->centre_x ? 1.0 : -1.0;
+          rt.force[i] = Vec3(side * a * model.mass[i], 0.0, 0.0);
+        }
+        hair::LcpStepInput in;
+        in.dt = dt;
+        in.head.t = rt.state.time;
+        in.external_force = &rt.force;
+        rep = rt.solver->step(ctx, in, rt.state, *rt.ws);
+      } else {
+        rep = rt.sim->step(ctx, dt);
+      }
+      ++rt.steps;
+      if (!rep.ok)
+        fail_at(m_source,
+                "lcp: the simulation failed at frame {} (t = {:.4f} s): {}; try more "
+                "lcp.dynamics.substeps or lcp.steps_per_frame",
+                f, rt.solver ? rt.state.time : rt.sim->time(), rep.message);
+    }
+    rt.state_frame = f;
+  }
+  std::vector<Vec3> x, t;
+  if (rt.solver) {
+    anim::RigidSample still;
+    still.t = rt.state.time;
+    hair::lcp_world(rt.state, still, &x, nullptr, &t);
+  } else {
+    rt.sim->world(x, &t);
+  }
+  auto ps = std::make_shared<geom::ParticleSet>();
+  ps->positions.reserve(x.size());
+  ps->directions.reserve(t.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    ps->positions.push_back(x[i].cast<float>());
+    ps->directions.push_back(t[i].cast<float>());
+  }
+  rt.last = std::move(ps);
+  rt.last_frame = frame;
+  rt.last_head = rt.solver ? Affine3::Identity() : rt.sim->head_pose().transform();
+  rt.last_air.reset();
+  if (const auto* air = rt.sim->air(); air && spec.render.show_air) {
+    auto ap = std::make_shared<geom::ParticleSet>();
+    for (const auto& p : air->positions()) ap->positions.push_back(p.cast<float>());
+    rt.last_air = std::move(ap);
+  }
+  return rt.last;
+}
+
+void Session::add_lcp_items(render::RenderScene& rs, int frame) {
+  if (!m_scene.lcp) return;
+  const LcpSpec& spec = *m_scene.lcp;
+  auto particles = lcp_particles(frame);
+  const LcpRuntime& rt = *m_lcp;
+  if (spec.render.show_head) {
+    render::MeshItem head;
+    head.mesh = rt.head;
+    head.transform = rt.last_head;
+    head.material.base_color = spec.render.head_color;
+    head.material.specular = 0.1;
+    head.material.ambient = 0.2;
+    rs.meshes.push_back(std::move(head));
+  }
+  render::ParticleItem item;
+  item.particles = std::move(particles);
+  item.shading = render::ParticleShading::HairSplat;
+  item.color = spec.render.color;
+  item.radius = spec.render.radius;
+  item.opacity = spec.render.opacity;
+  item.splat = spec.render.splat;
+  rs.particles.push_back(std::move(item));
+  if (rt.last_air) {
+    render::ParticleItem air;
+    air.particles = rt.last_air;
+    air.shading = render::ParticleShading::Flat;
+    air.color = Vec3(0.55, 0.75, 1.0);
+    air.radius = spec.render.air_radius;
+    air.opacity = 0.5;
+    rs.particles.push_back(std::move(air));
+  }
+}
+
+}  // namespace follicle::scene

@@ -1,0 +1,68 @@
+#include "follicle/scene/skin_section.hpp"
+
+#include <fmt/format.h>
+
+#include <set>
+
+#include "follicle/anim/keyframe_track.hpp"
+#include "follicle/core/error.hpp"
+
+namespace follicle::scene {
+
+skin::SkinColorParams SkinColorSpec::resolve() const {
+  skin::SkinColorParams p = skin::skin_color_preset(preset);
+  if (melanin) p.melanin = *melanin;
+  if (hemoglobin) p.hemoglobin = *hemoglobin;
+  return p;
+}
+
+void validate_skin_section(const std::vector<SkinSpec>& skin,
+                           const std::vector<std::string>& mesh_names, bool has_animation,
+                           const JsonSource& src) {
+  const std::set<std::string> names(mesh_names.begin(), mesh_names.end());
+  std::set<std::string> rigged;
+  for (std::size_t i = 0; i < skin.size(); ++i) {
+    const auto& s = skin[i];
+    const std::string p = index_path("skin", i);
+    if (s.mesh.empty()) json_fail(src, p + ".mesh", "mesh name is empty");
+    if (!names.count(s.mesh)) {
+      std::vector<std::string> known;
+      for (const auto& n : mesh_names)
+        if (!n.empty()) known.push_back(n);
+      const std::string hint = suggest(s.mesh, known);
+      json_fail(src, p + ".mesh",
+                "no mesh asset named \"" + s.mesh + "\"" +
+                    (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
+                    "; a face rig deforms a mesh of assets.meshes with that name");
+    }
+    if (!rigged.insert(s.mesh).second)
+      json_fail(src, p + ".mesh", "mesh \"" + s.mesh + "\" already has a face rig");
+    if (s.muscles.empty()) json_fail(src, p + ".muscles", "face-setup file path is empty");
+    try {
+      s.color.resolve();
+    } catch (const Error& e) {
+      json_fail(src, p + ".color.preset", e.what());
+    }
+    try {
+      (void)anim::parse_interp(s.interp);
+    } catch (const Error&) {
+      json_fail(src, p + ".interp",
+                "unknown value \"" + s.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
+    }
+    std::set<std::string> over;
+    for (std::size_t k = 0; k < s.wrinkle_overrides.size(); ++k)
+      if (!over.insert(s.wrinkle_overrides[k].name).second)
+        json_fail(src, index_path(p + ".wrinkle_overrides", k) + ".name",
+                  "wrinkle \"" + s.wrinkle_overrides[k].name + "\" is overridden twice");
+    if (!s.track.empty() && !has_animation)
+      json_fail(src, p + ".track",
+                "a contraction track needs an \"animation\" section (fps and frames or duration)");
+    for (std::size_t k = 1; k < s.track.size(); ++k)
+      if (!(s.track[k].t > s.track[k - 1].t))
+        json_fail(src, index_path(p + ".track", k) + ".t",
+                  fmt::format("key times must increase strictly ({} after {})", s.track[k].t,
+                              s.track[k - 1].t));
+  }
+}
+
+}  // namespace follicle::scene

@@ -1,0 +1,159 @@
+#pragma once
+// Scene section for expressive skin (Bando 2002 §2.5, §2.7): `"skin": [...]`, one face rig per
+// mesh asset: Waters muscles from a face-setup file (data/muscles/*.json), an expression or
+// explicit contractions, subcutaneous tissue, large-scale wrinkles (switchable, editable, r for
+// aged skin), skin colour (2.6) and the shading model; plus an optional contraction track
+// (keyframes of expressions / per-muscle contractions over the scene's animation clock).
+// Same pattern as scene.hpp: every struct lists its keys once in visit().
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "follicle/core/params.hpp"
+#include "follicle/core/types.hpp"
+#include "follicle/scene/json_params.hpp"
+#include "follicle/skin/adaptive_refine_volino1999.hpp"
+#include "follicle/skin/large_wrinkles_bando2002.hpp"
+#include "follicle/skin/skin_color_bando2002.hpp"
+#include "follicle/skin/tissue_bando2002.hpp"
+
+namespace follicle::scene {
+
+enum class SkinShading { Lafortune, BlinnPhong };
+constexpr std::array<std::pair<SkinShading, const char*>, 2> follicle_enum_names(SkinShading) {
+  return {{{SkinShading::Lafortune, "lafortune"}, {SkinShading::BlinnPhong, "blinn_phong"}}};
+}
+
+enum class SkinAlbedo { SkinColor, Texture };
+constexpr std::array<std::pair<SkinAlbedo, const char*>, 2> follicle_enum_names(SkinAlbedo) {
+  return {{{SkinAlbedo::SkinColor, "skin_color"}, {SkinAlbedo::Texture, "texture"}}};
+}
+
+/// Skin colour c = b - m a_m - h a_h (2.6): a preset, optionally with its own m and h.
+struct SkinColorSpec {
+  std::string preset = "caucasian";
+  std::optional<double> melanin;
+  std::optional<double> hemoglobin;
+
+  template <class V>
+  void visit(V&& v) {
+    v("preset", preset,
+      ParamInfo{"colour preset: pale, caucasian, asian, tanned, african (Bando 2002 §2.7)"});
+    v("melanin", melanin, ParamInfo{"amount of melanin m (default: the preset's)", "", 0.0, 1.0});
+    v("hemoglobin", hemoglobin,
+      ParamInfo{"amount of hemoglobin h (default: the preset's)", "", 0.0, 1.0});
+  }
+  /// The preset with the overrides applied; throws follicle::Error for an unknown preset.
+  skin::SkinColorParams resolve() const;
+};
+
+/// Edits one wrinkle of the face-setup file, found by name; absent keys keep the file's value.
+struct WrinkleOverride {
+  static constexpr const char* kRequired[] = {"name"};
+  std::string name;
+  std::optional<double> depth, width, r, end_taper;
+  std::optional<Vec2> p0, p1, p2, p3;
+
+  template <class V>
+  void visit(V&& v) {
+    v("name", name, ParamInfo{"name of a wrinkle of the face-setup file"});
+    v("depth", depth, ParamInfo{"furrow depth d", "m", 0.0, 0.1});
+    v("width", width, ParamInfo{"furrow width w", "m", 1e-6, 0.1});
+    v("r", r, ParamInfo{"rest amplitude ratio r of (2.4) (r > 0: visible at rest, aged skin)", "",
+                        0.0, 1.0});
+    v("end_taper", end_taper, ParamInfo{"end taper fraction", "", 0.0, 0.5});
+    v("p0", p0, ParamInfo{"Bezier control point 0 (texture space)", "", -10.0, 10.0});
+    v("p1", p1, ParamInfo{"Bezier control point 1 (texture space)", "", -10.0, 10.0});
+    v("p2", p2, ParamInfo{"Bezier control point 2 (texture space)", "", -10.0, 10.0});
+    v("p3", p3, ParamInfo{"Bezier control point 3 (texture space)", "", -10.0, 10.0});
+  }
+};
+
+/// One key of a contraction track: a pose (expression * weight, then explicit contractions and
+/// jaw angle) at time t. Poses between keys are interpolated per muscle (anim::KeyframeTrack).
+struct SkinKey {
+  static constexpr const char* kRequired[] = {"t"};
+  double t = 0.0;
+  std::string expression = "neutral";
+  double weight = 1.0;
+  std::map<std::string, double> contractions;
+  std::optional<double> jaw_angle;
+
+  template <class V>
+  void visit(V&& v) {
+    v("t", t, ParamInfo{"key time", "s", 0.0, 1e6});
+    v("expression", expression, ParamInfo{"expression of the face-setup file"});
+    v("weight", weight, ParamInfo{"expression weight (0 neutral, 1 full)", "", -2.0, 2.0});
+    v("contractions", contractions,
+      ParamInfo{"per-muscle contractions by name, replacing the expression's", "", -10.0, 10.0});
+    v("jaw_angle", jaw_angle, ParamInfo{"jaw opening, replacing the expression's", "rad", -1.5,
+                                        1.5});
+  }
+};
+
+/// A face rig on one mesh asset.
+struct SkinSpec {
+  static constexpr const char* kRequired[] = {"mesh", "muscles"};
+  std::string mesh;
+  std::string muscles;
+  std::string expression = "neutral";
+  double weight = 1.0;
+  std::map<std::string, double> contractions;
+  std::optional<double> jaw_angle;
+  bool wrinkles = true;
+  std::optional<double> wrinkle_r;
+  std::vector<WrinkleOverride> wrinkle_overrides;
+  std::vector<skin::LargeWrinkle> add_wrinkles;
+  skin::TissueParams tissue;
+  skin::RefineParams refine;
+  SkinAlbedo albedo = SkinAlbedo::SkinColor;
+  SkinColorSpec color;
+  SkinShading shading = SkinShading::Lafortune;
+  std::vector<SkinKey> track;
+  std::string interp = "smooth";
+
+  template <class V>
+  void visit(V&& v) {
+    v("mesh", mesh, ParamInfo{"name of the mesh asset (assets.meshes[].name) the rig deforms"});
+    v("muscles", muscles,
+      ParamInfo{"face-setup file (muscles, expressions, wrinkles; e.g. "
+                "data/muscles/lee_perry_smith.json), relative to the scene file"});
+    v("expression", expression,
+      ParamInfo{"expression of the face-setup file shown when there is no track"});
+    v("weight", weight, ParamInfo{"expression weight (0 neutral, 1 full)", "", -2.0, 2.0});
+    v("contractions", contractions,
+      ParamInfo{"per-muscle contractions by name, replacing the expression's", "", -10.0, 10.0});
+    v("jaw_angle", jaw_angle,
+      ParamInfo{"jaw opening, replacing the expression's", "rad", -1.5, 1.5});
+    v("wrinkles", wrinkles,
+      ParamInfo{"apply the large-scale wrinkles (false: the same face without furrows)"});
+    v("wrinkle_r", wrinkle_r,
+      ParamInfo{"rest amplitude ratio r of (2.4) for every wrinkle (r > 0: aged skin, furrows at "
+                "rest)",
+                "", 0.0, 1.0});
+    v("wrinkle_overrides", wrinkle_overrides,
+      ParamInfo{"per-wrinkle edits by name (applied after wrinkle_r)"});
+    v("add_wrinkles", add_wrinkles, ParamInfo{"extra wrinkles (Bezier furrows in texture space)"});
+    v("tissue", tissue,
+      ParamInfo{"subcutaneous tissue (thickness_map relative to the scene file)"});
+    v("refine", refine, ParamInfo{"adaptive refinement around the wrinkles"});
+    v("albedo", albedo,
+      ParamInfo{"skin_color: the colour of `color` per vertex; texture: the mesh asset's texture"});
+    v("color", color, ParamInfo{"skin colour (2.6) from melanin and hemoglobin"});
+    v("shading", shading, ParamInfo{"lafortune (skin BRDF, Bando 2002 §2.7) or blinn_phong"});
+    v("track", track,
+      ParamInfo{"contraction keyframes over the animation clock (needs \"animation\")"});
+    v("interp", interp, ParamInfo{"track interpolation: step, linear, smooth"});
+  }
+};
+
+/// Cross-field checks of the skin section (mesh names, track order, colour preset); errors name
+/// the file and JSON path. Called by Scene::validate.
+void validate_skin_section(const std::vector<SkinSpec>& skin,
+                           const std::vector<std::string>& mesh_names, bool has_animation,
+                           const JsonSource& src);
+
+}  // namespace follicle::scene
