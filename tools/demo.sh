@@ -16,3 +16,9 @@ echo "demo: wrote out/anjyo-bob.png"
 "$FOLLICLE" animate data/scenes/anjyo_wind.json -o out/anjyo-wind-frames --mp4 out/anjyo-wind.mp4 \
   --cache out/anjyo-wind-cache
 echo "demo: wrote out/anjyo-wind.mp4"
+# Bando 2002 fine-scale and joint wrinkles on the skeleton-animated MakeHuman hand (Figs. 2.16,
+# 2.17): a still frame and the finger-flexion clip.
+"$FOLLICLE" render data/scenes/hand_rest.json -o out/hand.png
+echo "demo: wrote out/hand.png"
+"$FOLLICLE" animate data/scenes/hand_flexion_anim.json -o out/hand-frames --mp4 out/hand.mp4
+echo "demo: wrote out/hand.mp4"

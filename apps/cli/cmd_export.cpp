@@ -14,9 +14,16 @@
 namespace follicle::cli {
 
 int run_export(const GlobalOptions& g, const ExportArgs& a) {
-  if (a.hair.empty() && a.maps.empty())
-    throw UsageError("nothing to export: give --hair out.hair|.tfx|.usda|.obj or --maps DIR");
+  if (a.hair.empty() && a.maps.empty() && a.mesh.empty())
+    throw UsageError(
+        "nothing to export: give --hair out.hair|.tfx|.usda|.obj, --maps DIR or --mesh "
+        "out.obj|.ply|.glb");
   if (!a.frames.empty() && a.maps.empty()) throw UsageError("--frames applies to --maps only");
+  if (!a.rig.empty() && a.mesh.empty()) throw UsageError("--rig applies to --mesh only");
+  if (!a.mesh.empty()) {
+    run_export_mesh(g, a);  // cmd_export_mesh.cpp
+    if (a.hair.empty() && a.maps.empty()) return 0;
+  }
   if (!a.maps.empty()) {
     run_export_maps(g, a);
     if (a.hair.empty()) return 0;

@@ -72,10 +72,23 @@ struct ExportArgs {
   std::string cache;  // strand cache folder, "" = none
   std::string maps;    // wrinkle-map folder, "" = none (cmd_export_maps.cpp)
   std::string frames;  // "A-B" for --maps, "" = every frame
+  std::string mesh;    // deformed face mesh (.obj, .ply, .gltf, .glb), "" = none
+  std::string rig;     // --mesh: mesh asset name of the face rig, "" = the first rig
 };
 int run_export(const GlobalOptions& g, const ExportArgs& a);
 /// The --maps part of `follicle export` (cmd_export_maps.cpp).
 int run_export_maps(const GlobalOptions& g, const ExportArgs& a);
+/// The --mesh part of `follicle export` (cmd_export_mesh.cpp).
+int run_export_mesh(const GlobalOptions& g, const ExportArgs& a);
+
+struct CompareArgs {
+  std::string a, b;    // mesh files
+  std::string output;  // error-coloured render of A (.png), "" = none
+  std::string units = "m";
+  int width = 800, height = 800;
+  uint64_t samples = 100000;
+};
+int run_compare(const GlobalOptions& g, const CompareArgs& a);
 
 struct AnimateArgs {
   std::string scene;

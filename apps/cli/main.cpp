@@ -81,7 +81,9 @@ int main(int argc, char** argv) {
 
   ExportArgs ea;
   auto* exp = app.add_subcommand(
-      "export", "write a scene's hair to a strand file or its wrinkle maps to images");
+      "export",
+      "write a scene's hair to a strand file, its wrinkle maps to images or its deformed face "
+      "mesh");
   exp->add_option("scene", ea.scene, "scene file (.json)")->required();
   exp->add_option("--hair", ea.hair, "output strand file: .hair, .tfx, .usda or .obj");
   exp->add_option("--maps", ea.maps,
@@ -92,6 +94,29 @@ int main(int argc, char** argv) {
   exp->add_option("--units", ea.units, "length unit written to the file: mm, cm, dm, m")
       ->capture_default_str();
   exp->add_option("--cache", ea.cache, "strand cache folder (reuse simulated frames)");
+  exp->add_option("--mesh", ea.mesh,
+                  "output mesh of the deformed, wrinkled face (.obj, .ply, .gltf, .glb), in the "
+                  "mesh file's coordinates");
+  exp->add_option("--rig", ea.rig, "face rig of --mesh by mesh asset name (default: the first)");
+
+  CompareArgs cma;
+  auto* compare = app.add_subcommand(
+      "compare", "distances between two meshes (mean, RMS, p95, max) and an error render");
+  compare->add_option("a", cma.a, "first mesh (.obj, .ply, .gltf, .glb)")->required();
+  compare->add_option("b", cma.b, "second mesh")->required();
+  compare->add_option("-o,--output", cma.output,
+                      "PNG of A coloured by its distance to B (blue 0 .. red max)");
+  compare->add_option("--units", cma.units, "length unit of both files and of the printed numbers")
+      ->capture_default_str();
+  compare->add_option("--width", cma.width, "width of the error render")
+      ->check(CLI::Range(16, 16384))
+      ->capture_default_str();
+  compare->add_option("--height", cma.height, "height of the error render")
+      ->check(CLI::Range(16, 16384))
+      ->capture_default_str();
+  compare->add_option("--samples", cma.samples, "area-uniform samples per mesh")
+      ->check(CLI::Range(uint64_t(1), uint64_t(1000000000)))
+      ->capture_default_str();
 
   AnimateArgs aa;
   auto* animate = app.add_subcommand("animate", "render an animation to numbered PNGs and an MP4");
@@ -131,6 +156,7 @@ int main(int argc, char** argv) {
     if (*docs) return run_docs(g, da);
     if (*exp) return run_export(g, ea);
     if (*animate) return run_animate(g, aa);
+    if (*compare) return run_compare(g, cma);
     return report("no command given (run 'follicle --help')", 2);
   } catch (const UsageError& e) {
     return report(e.what(), 2);
