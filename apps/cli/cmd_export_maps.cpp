@@ -14,38 +14,10 @@
 
 namespace follicle::cli {
 
-namespace {
-
-// "A-B" or "A" -> [first, last]; -1 for an absent bound. (Same syntax as animate --frames.)
-void parse_map_frames(const std::string& s, int& first, int& last) {
-  const auto bad = [&] {
-    return UsageError(
-        fmt::format("--frames expects A-B (e.g. 0-47) or one frame number, got '{}'", s));
-  };
-  if (s.empty()) return;
-  const auto dash = s.find('-');
-  auto num = [&](const std::string& t) {
-    if (t.empty() || t.size() > 9) throw bad();
-    for (char c : t)
-      if (!std::isdigit(static_cast<unsigned char>(c))) throw bad();
-    return std::stoi(t);
-  };
-  if (dash == std::string::npos) {
-    first = last = num(s);
-  } else {
-    first = num(s.substr(0, dash));
-    last = num(s.substr(dash + 1));
-  }
-  if (last < first)
-    throw UsageError(fmt::format("--frames {}: the last frame is before the first", s));
-}
-
-}  // namespace
-
 int run_export_maps(const GlobalOptions& g, const ExportArgs& a) {
   auto ctx = make_context(g);
   int first = -1, last = -1;
-  parse_map_frames(a.frames, first, last);
+  parse_frames(a.frames, first, last);
   auto session = scene::Session::load(a.scene, *ctx);
   if (!session.scene().hand)
     fail_at(a.scene,
