@@ -20,8 +20,7 @@ int run_export_mesh(const GlobalOptions& g, const ExportArgs& a) {
   auto ext = std::filesystem::path(a.mesh).extension().string();
   for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (ext != ".obj" && ext != ".ply" && ext != ".gltf" && ext != ".glb")
-    throw UsageError(
-        fmt::format("--mesh must end in .obj, .ply, .gltf or .glb, got '{}'", a.mesh));
+    throw UsageError(fmt::format("--mesh must end in .obj, .ply, .gltf or .glb, got '{}'", a.mesh));
   if (a.frame < 0) throw UsageError(fmt::format("--frame must be >= 0, got {}", a.frame));
   const LengthUnit unit = parse_length_unit(a.units);
 
@@ -45,21 +44,22 @@ int run_export_mesh(const GlobalOptions& g, const ExportArgs& a) {
       std::string list;
       for (const auto& n : names) list += (list.empty() ? "\"" : ", \"") + n + "\"";
       const std::string hint = did_you_mean(a.rig, names);
-      throw UsageError(fmt::format("--rig '{}': the scene has no face rig on that mesh{}; rigs: {}",
-                                   a.rig, hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
-                                   list));
+      throw UsageError(
+          fmt::format("--rig '{}': the scene has no face rig on that mesh{}; rigs: {}", a.rig,
+                      hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), list));
     }
   }
   if (a.frame >= session.frame_count())
     throw UsageError(fmt::format("--frame {} is past the scene's last frame {}", a.frame,
                                  session.frame_count() - 1));
   const auto mesh = session.skin_mesh(ri, a.frame);  // errors name the scene and JSON path
-  geom::save_mesh(*mesh, a.mesh, unit);               // atomic (temp file + rename)
+  geom::save_mesh(*mesh, a.mesh, unit);              // atomic (temp file + rename)
   if (!g.quiet)
-    fmt::print("wrote {} (face rig on mesh \"{}\", {} vertices, {} faces, frame {}, wrinkles {}, "
-               "{})\n",
-               a.mesh, skin[ri].mesh, mesh->num_vertices(), mesh->num_faces(), a.frame,
-               skin[ri].wrinkles ? "on" : "off", to_string(unit));
+    fmt::print(
+        "wrote {} (face rig on mesh \"{}\", {} vertices, {} faces, frame {}, wrinkles {}, "
+        "{})\n",
+        a.mesh, skin[ri].mesh, mesh->num_vertices(), mesh->num_faces(), a.frame,
+        skin[ri].wrinkles ? "on" : "off", to_string(unit));
   return 0;
 }
 

@@ -28,6 +28,9 @@ struct GlobalOptions {
 
 /// The Context every command runs with (logger level from --quiet/--verbose).
 std::unique_ptr<Context> make_context(const GlobalOptions& g);
+/// Parses a --frames value "A-B" or "A" into [first, last] (both left unchanged when `s` is
+/// empty); throws UsageError for anything else or when B < A.
+void parse_frames(const std::string& s, int& first, int& last);
 
 struct RenderArgs {
   std::string scene;

@@ -16,6 +16,7 @@ void add_skin_workloads(std::vector<Workload>& out);
 void add_splat_workloads(std::vector<Workload>& out);
 void add_lcp_workloads(std::vector<Workload>& out);
 void add_hair_render_workloads(std::vector<Workload>& out);
+void add_face_render_workloads(std::vector<Workload>& out);
 
 std::vector<Workload> all_workloads() {
   std::vector<Workload> out;
@@ -27,6 +28,7 @@ std::vector<Workload> all_workloads() {
   add_splat_workloads(out);
   add_lcp_workloads(out);
   add_hair_render_workloads(out);
+  add_face_render_workloads(out);
   return out;
 }
 
