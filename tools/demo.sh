@@ -16,6 +16,11 @@ echo "demo: wrote out/anjyo-bob.png"
 "$FOLLICLE" animate data/scenes/anjyo_wind.json -o out/anjyo-wind-frames --mp4 out/anjyo-wind.mp4 \
   --cache out/anjyo-wind-cache
 echo "demo: wrote out/anjyo-wind.mp4"
+# Bando 2002 expressive wrinkles on the default head (Figs. 2.11, 2.13).
+"$FOLLICLE" render data/scenes/skin_angry.json -o out/wrinkles-angry.png
+echo "demo: wrote out/wrinkles-angry.png"
+"$FOLLICLE" render data/scenes/skin_smile.json -o out/wrinkles-smile.png
+echo "demo: wrote out/wrinkles-smile.png"
 # Bando 2002 fine-scale and joint wrinkles on the skeleton-animated MakeHuman hand (Figs. 2.16,
 # 2.17): a still frame and the finger-flexion clip.
 "$FOLLICLE" render data/scenes/hand_rest.json -o out/hand.png
