@@ -1,5 +1,6 @@
 // Anjyo 1992 workloads: cantilever styling and projective dynamics at the sizes.
 #include <memory>
+#include <utility>
 
 #include "follicle/core/rng.hpp"
 #include "follicle/hair/hairdressing_anjyo1992.hpp"
@@ -53,9 +54,34 @@ class StyleInstance : public WorkloadInstance {
   hair::HairPart m_part;
 };
 
+// A closed triangulated ellipsoid: the bench hull grown by `grow` (the mesh collision's head).
+geom::TriMesh ellipsoid_mesh(const sim::Ellipsoid& e, double grow, int rings, int sectors) {
+  geom::TriMesh m;
+  const sim::Ellipsoid g = e.grown(grow);
+  m.positions.push_back(g.surface_point(0.0, 0.0));
+  for (int r = 1; r < rings; ++r)
+    for (int k = 0; k < sectors; ++k)
+      m.positions.push_back(g.surface_point(-kPi + 2 * kPi * k / sectors, kPi * r / rings));
+  m.positions.push_back(g.surface_point(0.0, kPi));
+  auto at = [&](int r, int k) { return 1 + (r - 1) * sectors + (k % sectors); };
+  const int last = int(m.positions.size()) - 1;
+  for (int k = 0; k < sectors; ++k) {
+    m.faces.push_back(Vec3i(0, at(1, k), at(1, k + 1)));
+    m.faces.push_back(Vec3i(last, at(rings - 1, k + 1), at(rings - 1, k)));
+    for (int r = 1; r + 1 < rings; ++r) {
+      m.faces.push_back(Vec3i(at(r, k), at(r + 1, k), at(r + 1, k + 1)));
+      m.faces.push_back(Vec3i(at(r, k), at(r + 1, k + 1), at(r, k + 1)));
+    }
+  }
+  // Orientation: outward normals (the signed distance's sign).
+  if (m.face_normal(0).dot(m.positions[std::size_t(m.faces[0][1])] - g.centre) < 0)
+    for (auto& f : m.faces) std::swap(f[1], f[2]);
+  return m;
+}
+
 class DynamicsInstance : public WorkloadInstance {
  public:
-  DynamicsInstance(const Context& ctx, const Sizes& s) : m_ctx(ctx) {
+  DynamicsInstance(const Context& ctx, const Sizes& s, bool mesh = false) : m_ctx(ctx) {
     const auto roots = bench_roots(std::size_t(s.at("strands")), 0.24);
     hair::HairPart part = hair::style_preset("bob").parts[0];
     part.beam.segments = int(s.at("segments"));
@@ -66,6 +92,9 @@ class DynamicsInstance : public WorkloadInstance {
     p.dt = 1.0 / 60.0;
     p.stiffness_deg = 15.0;
     m_solver = std::make_unique<hair::ProjectiveSolver>(p, bench_hull(), rest, 1);
+    if (mesh)
+      m_solver->set_collision_grid(hair::head_collision_grid(
+          ctx, ellipsoid_mesh(bench_hull(), 0.002, 64, 128), bench_hull(), p));
     m_state = m_solver->initial_state();
   }
   void run_once() override {
@@ -97,6 +126,14 @@ void add_anjyo_workloads(std::vector<Workload>& out) {
                  "steps/s",
                  [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
                    return std::make_unique<DynamicsInstance>(ctx, s);
+                 }});
+  out.push_back({"anjyo-dynamics-mesh",
+                 "anjyo-dynamics with the mesh collision (signed-distance grid of a triangulated "
+                 "head 2 mm outside the hull)",
+                 {{"strands", 100000}, {"segments", 20}},
+                 "steps/s",
+                 [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
+                   return std::make_unique<DynamicsInstance>(ctx, s, true);
                  }});
 }
 

@@ -22,6 +22,8 @@ void ProjectiveParams::validate() const {
   if (inertia != "paper" && inertia != "uniform")
     fail_at("projective.inertia", "unknown inertia arrangement \"{}\"; expected paper or uniform",
             inertia);
+  if (collision != "mesh" && collision != "hull")
+    fail_at("projective.collision", "unknown collision \"{}\"; expected mesh or hull", collision);
 }
 
 namespace {
@@ -114,6 +116,20 @@ ProjectiveSolver::ProjectiveSolver(const ProjectiveParams& params, const sim::El
   }
 }
 
+std::shared_ptr<const geom::SignedDistanceGrid> head_collision_grid(
+    const Context& ctx, const geom::TriMesh& head, const sim::Ellipsoid& hull,
+    const ProjectiveParams& params) {
+  const geom::MeshSignedDistance sd(head);
+  geom::SignedDistanceGridParams gp;
+  gp.cell = params.collision_cell;
+  gp.band = std::max(0.01, 4.0 * gp.cell);
+  // Box of the hull (any rotation) grown by 4 cm: the hair near the skin; beyond it, far outside.
+  const Mat3 A = hull.rotation.cwiseAbs();
+  const Vec3 ext = A * hull.radii + Vec3::Constant(0.04);
+  return std::make_shared<const geom::SignedDistanceGrid>(ctx, sd, hull.centre - ext,
+                                                          hull.centre + ext, gp);
+}
+
 double ProjectiveSolver::gain(std::size_t s, int i) const {
   return m_gain[std::size_t(i - 1) * m_n + s];
 }
@@ -144,6 +160,8 @@ constexpr std::size_t kChunk = 256;  // strands per block: ~30 float scratch row
 struct StepArgs {
   const ProjectiveParams* p = nullptr;
   const sim::Ellipsoid* hull = nullptr;
+  const geom::SignedDistanceGrid* grid = nullptr;  // mesh collision (null: hull only)
+  float margin = 0;
   std::size_t N = 0, K = 0;
   uint64_t seed = 0, step = 0;
   const int* nseg = nullptr;
@@ -195,7 +213,6 @@ BlockFn pick_block_kernel() {
 
 }  // namespace
 
-
 // One step of (4)' and (5)'. Layout: [segment][strand] rows; the loop runs over blocks of
 // kChunk strands (parallel_chunks), and inside a block over segments i = 1..K (root to tip, each
 // segment needs the advanced p_{i-1}) with simple inner loops over the block's strands that the
@@ -246,6 +263,8 @@ sim::StepReport ProjectiveSolver::step(const Context& ctx, const ProjectiveInput
   StepArgs a;
   a.p = &m_p;
   a.hull = &m_hull;
+  a.grid = collision_grid();
+  a.margin = float(m_p.collision_margin);
   a.N = N;
   a.K = K;
   a.seed = m_seed;

@@ -10,11 +10,13 @@
 // rigid head motion. Everything is solved in the head frame (the frame of the hull: y up, z to
 // the face), as in Fig. 5a; the y axis of the θ plane is the head's.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "follicle/core/context.hpp"
 #include "follicle/core/types.hpp"
+#include "follicle/geom/mesh_sdf.hpp"
 #include "follicle/geom/strands.hpp"
 #include "follicle/sim/ellipsoid.hpp"
 #include "follicle/sim/step_report.hpp"
@@ -41,7 +43,14 @@ struct ProjectiveParams {
   double rest_spring = 0.0;           // [1/s²] pull towards the styled angles (not in the paper)
   double parallel_threshold = 0.05;   // |sin θ| below which the θ plane is spanned by y and F
   bool ellipsoid_constraint = false;  // hard push-out of nodes from the hull (not in the paper)
-  double max_speed = 100.0;           // [m/s] blow-up limit reported in StepReport
+  // Collision with the real head surface (not in the paper, which knows only the hull): "mesh"
+  // pushes every node whose signed distance to the head mesh (grid, set_collision_grid) is below
+  // collision_margin back out by turning its segment about p_{i-1} (the stick keeps its length);
+  // "hull": the hull alone, as in the paper (pseudo-force field, ellipsoid_constraint).
+  std::string collision = "mesh";
+  double collision_margin = 0.002;  // [m] clearance kept above the skin
+  double collision_cell = 0.0025;   // [m] spacing of the signed-distance grid
+  double max_speed = 100.0;         // [m/s] blow-up limit reported in StepReport
 
   template <class V>
   void visit(V&& v) {
@@ -68,6 +77,13 @@ struct ProjectiveParams {
     v("parallel_threshold", parallel_threshold,
       {"|sin theta| of a segment parallel to y", "", 0.0, 0.5});
     v("ellipsoid_constraint", ellipsoid_constraint, {"push nodes out of the hull"});
+    v("collision", collision,
+      {"mesh (push nodes out of the head mesh, not in the paper) | hull (the hull only, as in "
+       "the paper)"});
+    v("collision_margin", collision_margin,
+      {"clearance of the mesh collision above the skin", "m", 0.0, 0.01});
+    v("collision_cell", collision_cell,
+      {"cell of the head's signed-distance grid (mesh collision)", "m", 5e-4, 0.02});
     v("max_speed", max_speed, {"blow-up speed", "m/s", 1e-3, 1e6});
   }
   void validate() const;
@@ -119,6 +135,15 @@ class ProjectiveSolver {
   ProjectiveSolver(const ProjectiveParams& params, const sim::Ellipsoid& hull,
                    const geom::StrandSet& rest, uint64_t seed);
 
+  /// Mesh collision (params().collision == "mesh"): the signed distance of the head surface in
+  /// the head frame. Without a grid (or with collision "hull") only the hull is known.
+  void set_collision_grid(std::shared_ptr<const geom::SignedDistanceGrid> grid) {
+    m_grid = std::move(grid);
+  }
+  const geom::SignedDistanceGrid* collision_grid() const {
+    return m_p.collision == "mesh" ? m_grid.get() : nullptr;
+  }
+
   /// Still hair in the styled shape: θ^0 = θ^{-1} = θ^init, φ^0 = φ^{-1} = φ^init.
   ProjectiveState initial_state() const;
   /// One step of (4)' and (5)'; parallel over strand chunks, identical for any thread count.
@@ -135,6 +160,7 @@ class ProjectiveSolver {
  private:
   ProjectiveParams m_p;
   sim::Ellipsoid m_hull;
+  std::shared_ptr<const geom::SignedDistanceGrid> m_grid;
   geom::StrandSet m_rest;
   uint64_t m_seed;
   std::size_t m_n = 0;
@@ -149,6 +175,13 @@ class ProjectiveSolver {
   std::vector<float> m_dir0x, m_dir0y, m_dir0z;  // [K*N] styled directions (rest_spring only)
   std::vector<float> m_rootx, m_rooty, m_rootz;  // [N]
 };
+
+/// The mesh collision's signed-distance grid of `head` (head frame, as the solver's hull): over
+/// the box of the hull grown by 4 cm, cell params.collision_cell, band max(1 cm, 4 cells).
+std::shared_ptr<const geom::SignedDistanceGrid> head_collision_grid(const Context& ctx,
+                                                                    const geom::TriMesh& head,
+                                                                    const sim::Ellipsoid& hull,
+                                                                    const ProjectiveParams& params);
 
 /// Direction of a segment from its angles: (sinθ sinφ, cosθ, sinθ cosφ).
 inline Vec3 segment_direction(double theta, double phi) {

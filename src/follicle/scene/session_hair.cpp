@@ -189,6 +189,16 @@ std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int
     hull_head.rotation = Mat3::Identity();
     try {
       g.solver = std::make_unique<hair::ProjectiveSolver>(h.dynamics, hull_head, rest, h.seed);
+      if (h.dynamics.collision == "mesh") {
+        // The head surface for the mesh collision, in the head frame (the mesh at rest).
+        const std::size_t mi = mesh_index(h.mesh);
+        geom::TriMesh head = *mesh(mi);
+        head.transform(m_scene.assets.meshes[mi].transform.matrix());
+        for (auto& p : head.positions) p = Rh.transpose() * (p - c);
+        head.normals.clear();
+        g.solver->set_collision_grid(
+            hair::head_collision_grid(*m_ctx, head, hull_head, h.dynamics));
+      }
     } catch (const Error& e) {
       fail("{}: dynamics: {}", where, e.what());
     }
