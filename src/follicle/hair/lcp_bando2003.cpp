@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <unordered_map>
 
@@ -415,6 +416,22 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
 
 // ---------------------------------------------------------------------------------------------
 // Dynamics
+//
+// Layout of a sub-step (step()): every loop runs over particles and writes only what that
+// particle owns: its own state, the connections of which it is the tip-side end (each connection
+// has exactly one), and the hair-hair pairs of its sorted neighbour list with a higher index. Per-
+// pair and per-connection values are then gathered in a fixed order, so results do not depend on
+// the thread count. Six parallel loops per sub-step:
+//   1. k_ij (3.7) + tethers, W(h, r) per pair, largest displacement since the list build
+//   2. alpha sums (3.13), density (3.1) and pressure
+//   3. alpha_ij (3.14), spring forces, hair-hair forces (3.16)-(3.18)
+//   4. gather of the forces, accelerations and the leapfrog update
+//   5. connection geometry at the new positions (shared by both ends and the next sub-step)
+//   6. direction update (3.15) and the blow-up check
+
+namespace {
+constexpr std::size_t kChunk = 256;  // particles per task of the fused loops
+}  // namespace
 
 LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPlanes* body)
     : m_params(params), m_model(std::move(model)), m_body(body) {
@@ -433,6 +450,9 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
   for (std::size_t q = 0; q < m_model.num_pairs(); ++q)
     if (m_model.pair_a[q] >= n || m_model.pair_b[q] >= n)
       fail_at(fmt::format("lcp.pairs[{}]", q), "particle index out of range");
+  for (std::size_t e = 0; e < m_model.adj_pairs.size(); ++e)
+    if (m_model.adj_pairs[e] >= np)
+      fail_at(fmt::format("lcp.adjacency[{}]", e), "connection index out of range");
   m_rho0 = m_params.rho0_scale * m_model.rest_density;
   m_sin_a.resize(m_model.num_pairs());
   m_sin_b.resize(m_model.num_pairs());
@@ -442,6 +462,21 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
   }
   m_ea.resize(n);
   for (std::size_t i = 0; i < n; ++i) m_ea[i] = m_params.elastic_modulus * cross_section(i);
+  // Root-side connections of each particle (those with pair_b == i), in adjacency order.
+  m_rs_offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    uint32_t c = 0;
+    for (uint32_t e = m_model.adj_offsets[i]; e < m_model.adj_offsets[i + 1]; ++e)
+      if (m_model.pair_b[m_model.adj_pairs[e]] == i) ++c;
+    m_rs_offsets[i + 1] = m_rs_offsets[i] + c;
+  }
+  m_rs_pairs.clear();
+  m_rs_pairs.reserve(m_rs_offsets[n]);
+  for (std::size_t i = 0; i < n; ++i)
+    for (uint32_t e = m_model.adj_offsets[i]; e < m_model.adj_offsets[i + 1]; ++e)
+      if (m_model.pair_b[m_model.adj_pairs[e]] == i) m_rs_pairs.push_back(m_model.adj_pairs[e]);
+  if (m_rs_pairs.size() != np)
+    fail_at("lcp", "every connection must appear once in the adjacency of each of its ends");
 }
 
 LcpState LcpSolver::rest_state() const {
@@ -456,69 +491,63 @@ double LcpSolver::cross_section(std::size_t i) const {
   return std::pow(m_model.mass[i] / m_params.material_density, 2.0 / 3.0);  // (3.9)
 }
 
-void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
+template <class R>
+void LcpSolver::coefficients_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
+                                R&& r_of) const {
   const auto& m = m_model;
-  const std::size_t np = m.num_pairs(), n = m.size();
-  ws.k.resize(np);
-  ws.alpha.resize(np);
-  ws.alpha_r.resize(n);
-  ws.alpha_t.resize(n);
-  parallel_for(ctx, 0, np, [&](std::size_t q) {
-    const double d = (s.x[m.pair_b[q]] - s.x[m.pair_a[q]]).norm();
-    ws.k[q] = m.c[q] * sph_w(m.h_s, d);  // (3.7) k_ij = c_ij W(h_s, |x_ij|)
-  });
+  const uint32_t r0 = m_rs_offsets[i], r1 = m_rs_offsets[i + 1];
+  for (uint32_t e = r0; e < r1; ++e) {
+    const uint32_t q = m_rs_pairs[e];
+    ws.k[q] = m.c[q] * sph_w(m.h_s, r_of(q));  // (3.7) k_ij = c_ij W(h_s, |x_ij|)
+  }
   // A particle whose root-side springs have all drawn apart beyond 2 h_s would be free and fall
   // off the head. Its nearest root-side spring is kept at the coefficient it has at r = 2 h_s
   // minus a margin (any positive k gives the full tensile modulus through (3.13)), so the hair
   // splits laterally but never tears lengthwise (not in the paper; see docs/equations/lcp.md).
-  // Each connection has exactly one tip-side end, so writing k[q] for pairs with pair_b == i is
-  // race-free.
-  const double k_floor_w = sph_w(m.h_s, kTetherFraction * 2 * m.h_s);
-  parallel_for(ctx, 0, n, [&](std::size_t i) {
-    const uint32_t e0 = m.adj_offsets[i], e1 = m.adj_offsets[i + 1];
-    if (!m.root[i]) {
-      uint32_t best = uint32_t(-1);
-      double bd = 1e300;
-      bool held = false;
-      for (uint32_t e = e0; e < e1 && !held; ++e) {
-        const uint32_t q = m.adj_pairs[e];
-        if (m.pair_b[q] != i) continue;
-        if (ws.k[q] > 0) {
-          held = true;
-          break;
-        }
-        const double d = (s.x[m.pair_a[q]] - s.x[i]).squaredNorm();
-        if (d < bd) {
-          bd = d;
-          best = q;
-        }
-      }
-      if (!held && best != uint32_t(-1)) ws.k[best] = m.c[best] * k_floor_w;
+  if (m.root[i]) return;
+  uint32_t best = uint32_t(-1);
+  double bd = 1e300;
+  for (uint32_t e = r0; e < r1; ++e) {
+    const uint32_t q = m_rs_pairs[e];
+    if (ws.k[q] > 0) return;  // held
+    const double d = (s.x[m.pair_a[q]] - s.x[i]).squaredNorm();
+    if (d < bd) {
+      bd = d;
+      best = q;
     }
-  });
-  // (3.13), after all tethers are set (a root-side end reads k of connections whose tip-side
-  // end may have just raised them).
-  parallel_for(ctx, 0, n, [&](std::size_t i) {
-    const uint32_t e0 = m.adj_offsets[i], e1 = m.adj_offsets[i + 1];
-    double sr = 0, st = 0;
-    for (uint32_t e = e0; e < e1; ++e) {
-      const uint32_t q = m.adj_pairs[e];
-      if (m.pair_b[q] == i)
-        sr += m.l0[q] * ws.k[q];  // the other end is in N_r(i)
-      else
-        st += m.l0[q] * ws.k[q];  // the other end is in N_t(i)
-    }
-    const double ea = m_ea[i];
-    ws.alpha_r[i] = sr > 0 ? ea / sr : 0.0;  // (3.13)
-    ws.alpha_t[i] = st > 0 ? ea / st : 0.0;
-  });
-  parallel_for(ctx, 0, np, [&](std::size_t q) {
-    // (3.14): a = pair_a is root-side (in N_r(b)), b is tip-side (in N_t(a)).
-    ws.alpha[q] = 0.5 * (ws.alpha_r[m.pair_b[q]] + ws.alpha_t[m.pair_a[q]]);
-  });
+  }
+  if (best != uint32_t(-1)) ws.k[best] = m.c[best] * sph_w(m.h_s, kTetherFraction * 2 * m.h_s);
+}
+
+void LcpSolver::alpha_sums_of(std::size_t i, LcpWorkspace& ws) const {
+  const auto& m = m_model;
+  double sr = 0, st = 0;
+  for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+    const uint32_t q = m.adj_pairs[e];
+    if (m.pair_b[q] == i)
+      sr += m.l0[q] * ws.k[q];  // the other end is in N_r(i)
+    else
+      st += m.l0[q] * ws.k[q];  // the other end is in N_t(i)
+  }
+  const double ea = m_ea[i];
+  ws.alpha_r[i] = sr > 0 ? ea / sr : 0.0;  // (3.13)
+  ws.alpha_t[i] = st > 0 ? ea / st : 0.0;
+}
+
+void LcpSolver::alpha_of(std::size_t i, LcpWorkspace& ws) const {
+  // (3.14): a = pair_a is root-side (in N_r(b)), b = i is tip-side (in N_t(a)).
+  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
+    const uint32_t q = m_rs_pairs[e];
+    ws.alpha[q] = 0.5 * (ws.alpha_r[i] + ws.alpha_t[m_model.pair_a[q]]);
+  }
+}
+
+void LcpSolver::alpha_sweeps(const Context& ctx, LcpWorkspace& ws) const {
   // Optional balancing (not in the paper): the average (3.14) satisfies neither (3.10) nor
   // (3.11) exactly. Each sweep scales alpha_ij by the geometric mean of E / E_{r,b} and
   // E / E_{t,a} of its two ends (iterative proportional fitting); still linear time.
+  const auto& m = m_model;
+  const std::size_t n = m.size(), np = m.num_pairs();
   for (int sweep = 0; sweep < m_params.alpha_sweeps; ++sweep) {
     parallel_for(ctx, 0, n, [&](std::size_t i) {
       double er = 0, et = 0;
@@ -540,6 +569,24 @@ void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace&
   }
 }
 
+void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
+  const auto& m = m_model;
+  const std::size_t np = m.num_pairs(), n = m.size();
+  ws.k.resize(np);
+  ws.alpha.resize(np);
+  ws.alpha_r.resize(n);
+  ws.alpha_t.resize(n);
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    coefficients_of(i, s, ws,
+                    [&](uint32_t q) { return (s.x[m.pair_b[q]] - s.x[m.pair_a[q]]).norm(); });
+  });
+  // (3.13), after all tethers are set (a root-side end reads k of connections whose tip-side
+  // end may have just raised them).
+  parallel_for(ctx, 0, n, [&](std::size_t i) { alpha_sums_of(i, ws); });
+  parallel_for(ctx, 0, n, [&](std::size_t i) { alpha_of(i, ws); });
+  alpha_sweeps(ctx, ws);
+}
+
 void LcpSolver::tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
                                std::vector<double>& e_t) const {
   const auto& m = m_model;
@@ -557,73 +604,144 @@ void LcpSolver::tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
   }
 }
 
-void LcpSolver::neighbours_and_density(const Context& ctx, const LcpState& s,
-                                       LcpWorkspace& ws) const {
-  const auto& m = m_model;
-  const double h = m.h;
-  const std::size_t n = m.size();
+void LcpSolver::rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
   // Verlet lists: all pairs within R = 2h + skin. A pair now closer than 2h was closer than
   // 2h + 2 d_max at the build, d_max the largest displacement since; so the lists stay complete
   // while 2 d_max < skin (rebuilt a little earlier to stay clear of rounding).
-  const double skin = m_params.neighbour_skin * 2 * h;
-  const double R = 2 * h + skin;
-  bool rebuild = skin <= 0 || ws.nbr_built_x.size() != n || ws.nbr_radius != R ||
-                 ws.nbr_offsets.size() != n + 1 || ws.nbr_mirror.size() != ws.nbrs.size();
-  if (!rebuild) {
-    const double d2 = deterministic_reduce(
-        ctx, n, 1024, 0.0,
-        [&](std::size_t i0, std::size_t i1) {
-          double d = 0;
-          for (std::size_t i = i0; i < i1; ++i)
-            d = std::max(d, (s.x[i] - ws.nbr_built_x[i]).squaredNorm());
-          return d;
-        },
-        [](double u, double w) { return std::max(u, w); });
-    const double lim = 0.49 * skin;
-    rebuild = !(d2 < lim * lim);  // also when a position is NaN
-  }
-  if (rebuild) {
-    ws.grid.build(s.x, R);
-    ws.grid.neighbour_lists(ctx, s.x, R, ws.nbr_offsets, ws.nbrs);
-    if (!sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
-      fail("lcp: neighbour lists are not symmetric (internal error)");
-    ws.nbr_built_x = s.x;
-    ws.nbr_radius = R;
-    ++ws.nbr_builds;
-  }
-  ws.density.resize(n);
-  ws.pressure.resize(n);
-  ws.pair_w.resize(ws.nbrs.size());
-  const SphKernel K(h);
-  const double r2max = 4 * h * h;
-  // W once per pair (at its lower-index end), then gathered per particle in list order.
+  const double h = m_model.h;
+  const double R = 2 * h + m_params.neighbour_skin * 2 * h;
+  ws.grid.build(s.x, R);
+  ws.grid.neighbour_lists(ctx, s.x, R, ws.nbr_offsets, ws.nbrs);
+  if (!sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
+    fail("lcp: neighbour lists are not symmetric (internal error)");
+  ws.nbr_built_x = s.x;
+  ws.nbr_radius = R;
+  ++ws.nbr_builds;
+}
+
+namespace {
+/// First entry of each sorted list with a neighbour index above the particle's own.
+void upper_starts(const Context& ctx, const std::vector<uint32_t>& off,
+                  const std::vector<uint32_t>& nb, std::vector<uint32_t>& upper) {
+  const std::size_t n = off.empty() ? 0 : off.size() - 1;
+  upper.resize(n);
   parallel_for(ctx, 0, n, [&](std::size_t i) {
-    const Vec3 xi = s.x[i];
-    for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-      const uint32_t j = ws.nbrs[e];
-      if (j < i) continue;
-      const double d2 = (s.x[j] - xi).squaredNorm();
-      ws.pair_w[e] = d2 < r2max ? K.w(std::sqrt(d2)) : 0.0;
-    }
+    upper[i] = uint32_t(
+        std::upper_bound(nb.begin() + off[i], nb.begin() + off[i + 1], uint32_t(i)) - nb.begin());
   });
-  const double w0 = K.w(0.0);
-  parallel_for(ctx, 0, n, [&](std::size_t i) {
-    double rho = m.mass[i] * w0;
-    for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-      const uint32_t j = ws.nbrs[e];
-      rho += m.mass[j] * ws.pair_w[j > i ? e : ws.nbr_mirror[e]];  // (3.1)
-    }
-    ws.density[i] = rho;
-    ws.pressure[i] = m_params.k_a * (rho - m_rho0);  // P = k_a (rho - rho0)
-  });
+}
+}  // namespace
+
+void LcpSolver::density_of(std::size_t i, LcpWorkspace& ws, double w0) const {
+  const auto& m = m_model;
+  double rho = m.mass[i] * w0;
+  for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+    const uint32_t j = ws.nbrs[e];
+    rho += m.mass[j] * ws.pair_w[j > i ? e : ws.nbr_mirror[e]];  // (3.1)
+  }
+  ws.density[i] = rho;
+  ws.pressure[i] = m_params.k_a * (rho - m_rho0);  // P = k_a (rho - rho0)
+  ws.p_rho2[i] = ws.pressure[i] / (rho * rho);
 }
 
 void LcpSolver::pair_forces(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
   // The caller may have built ws.nbrs itself (any order, any radius >= 2h): sort and mirror.
-  if (m_params.hair_hair && !ws.nbr_offsets.empty() &&
-      !sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
-    fail("lcp: pair_forces needs symmetric neighbour lists without self entries");
+  if (m_params.hair_hair && !ws.nbr_offsets.empty()) {
+    if (!sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
+      fail("lcp: pair_forces needs symmetric neighbour lists without self entries");
+    upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
+  }
   pair_forces_sorted(ctx, s, ws);
+}
+
+void LcpSolver::spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, double r,
+                          const Vec3& xh) const {
+  // Loose spring, once per connection: force on the root-side end a (b gets the negation).
+  const auto& m = m_model;
+  const auto& p = m_params;
+  if (!(r > 0)) {
+    ws.spring_f[q] = Vec3::Zero();
+    return;
+  }
+  const uint32_t a = m.pair_a[q], b = m.pair_b[q];
+  const double ak = ws.alpha[q] * ws.k[q];  // current coefficient alpha_ij k_ij
+  const double ext = r - m.l0[q];
+  // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
+  const double kk = ext < 0 ? ak * p.compression_scale : ak;
+  const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
+  const double cd = 2.0 * p.spring_damping * std::sqrt(kk * mu);
+  ws.spring_f[q] = (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
+}
+
+void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
+                              const SphKernel& K, double inv_w0) const {
+  // Hair-hair force (3.16)-(3.18) on i from j, once per pair (i < j); j gets the negation.
+  const auto& m = m_model;
+  const auto& p = m_params;
+  const double h = m.h, r2max = 4 * h * h;
+  const double eps2 = p.colinear_eps * p.colinear_eps;
+  const Vec3 xi = s.x[i], vi = s.v[i], ti = s.t[i];
+  const double mi = m.mass[i], pi = ws.p_rho2[i];
+  for (uint32_t e = ws.nbr_upper[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+    const uint32_t j = ws.nbrs[e];
+    const Vec3 xab = s.x[j] - xi;
+    const double r2 = xab.squaredNorm();
+    if (!(r2 < r2max) || !(r2 > 0)) {
+      ws.pair_f[e] = Vec3::Zero();
+      continue;
+    }
+    const double r = std::sqrt(r2);
+    const Vec3 xh = xab / r;
+    double w, dw;
+    K.w_dw(r, w, dw);
+    const double mj = m.mass[j];
+    // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i,
+    // dW/dx_i = -W' x^_ij
+    Vec3 f = mi * mj * (pi + ws.p_rho2[j]) * dw * xh;
+    // Collision direction d_n = t_i x t_j. Near-colinear hairs: the paper prints
+    // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is
+    // t_i, i.e. ALONG the hair, contradicting "normal to the hair directions". We use the
+    // part of x^_ij normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which the case needs.
+    Vec3 dn = ti.cross(s.t[j]);
+    double dn2 = dn.squaredNorm();
+    if (dn2 < eps2) {
+      dn = xh - xh.dot(ti) * ti;
+      dn2 = dn.squaredNorm();
+    }
+    if (dn2 >= 1e-18) {
+      const Vec3 dh = dn / std::sqrt(dn2);
+      const Vec3 vab = s.v[j] - vi;
+      // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one
+      // setting works for any particle count: d_c(paper) = d_c mu / W(h, 0).
+      const double muw = mi * mj / (mi + mj) * (w * inv_w0);
+      const double vn = vab.dot(dh);
+      if (vn * xab.dot(dh) < 0) f += p.collision_damping * muw * vn * dh;  // (3.17)
+      f += p.friction_damping * muw * (vab - vn * dh);  // (3.18) d_f W (v_ij . d^_t) d^_t
+    }
+    ws.pair_f[e] = f;
+  }
+}
+
+Vec3 LcpSolver::gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const {
+  // Gather in a fixed order (adjacency, then neighbour list): deterministic for any thread
+  // count, and each pair's two contributions are exact negations.
+  const auto& m = m_model;
+  Vec3 f = Vec3::Zero();
+  for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+    const uint32_t q = m.adj_pairs[e];
+    if (m.pair_a[q] == i)
+      f += ws.spring_f[q];
+    else
+      f -= ws.spring_f[q];
+  }
+  if (hh)
+    for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+      if (ws.nbrs[e] > i)
+        f += ws.pair_f[e];
+      else
+        f -= ws.pair_f[ws.nbr_mirror[e]];
+    }
+  return f;
 }
 
 void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
@@ -631,135 +749,72 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
   const auto& p = m_params;
   const std::size_t n = m.size(), np = m.num_pairs();
   ws.force.resize(n);
-  // Loose springs, once per connection: force on the root-side end a (b gets the negation).
   ws.spring_f.resize(np);
   parallel_for(ctx, 0, np, [&](std::size_t q) {
-    const uint32_t a = m.pair_a[q], b = m.pair_b[q];
-    const Vec3 d = s.x[b] - s.x[a];
+    const Vec3 d = s.x[m.pair_b[q]] - s.x[m.pair_a[q]];
     const double r = d.norm();
-    if (!(r > 0)) {
-      ws.spring_f[q] = Vec3::Zero();
-      return;
-    }
-    const Vec3 xh = d / r;
-    const double ak = ws.alpha[q] * ws.k[q];  // current coefficient alpha_ij k_ij
-    const double ext = r - m.l0[q];
-    // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
-    const double kk = ext < 0 ? ak * p.compression_scale : ak;
-    const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
-    const double cd = 2.0 * p.spring_damping * std::sqrt(kk * mu);
-    ws.spring_f[q] = (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
+    spring_of(q, s, ws, r, r > 0 ? Vec3(d / r) : Vec3::Zero());
   });
   const bool hh = p.hair_hair && ws.nbr_offsets.size() == n + 1 && ws.density.size() == n &&
-                  ws.pressure.size() == n && ws.nbr_mirror.size() == ws.nbrs.size();
+                  ws.pressure.size() == n && ws.nbr_mirror.size() == ws.nbrs.size() &&
+                  ws.nbr_upper.size() == n;
   if (hh) {
     ws.p_rho2.resize(n);
     for (std::size_t i = 0; i < n; ++i)
       ws.p_rho2[i] = ws.pressure[i] / (ws.density[i] * ws.density[i]);
     ws.pair_f.resize(ws.nbrs.size());
-    const double h = m.h, r2max = 4 * h * h;
-    const SphKernel K(h);
+    const SphKernel K(m.h);
     const double inv_w0 = 1.0 / K.w(0.0);
-    const double eps2 = p.colinear_eps * p.colinear_eps;
-    // Hair-hair force (3.16)-(3.18) on i from j, once per pair (i < j); j gets the negation.
-    parallel_for(ctx, 0, n, [&](std::size_t i) {
-      const Vec3 xi = s.x[i], vi = s.v[i], ti = s.t[i];
-      const double mi = m.mass[i], pi = ws.p_rho2[i];
-      for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-        const uint32_t j = ws.nbrs[e];
-        if (j < i) continue;
-        const Vec3 xab = s.x[j] - xi;
-        const double r2 = xab.squaredNorm();
-        if (!(r2 < r2max) || !(r2 > 0)) {
-          ws.pair_f[e] = Vec3::Zero();
-          continue;
-        }
-        const double r = std::sqrt(r2);
-        const Vec3 xh = xab / r;
-        double w, dw;
-        K.w_dw(r, w, dw);
-        const double mj = m.mass[j];
-        // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i,
-        // dW/dx_i = -W' x^_ij
-        Vec3 f = mi * mj * (pi + ws.p_rho2[j]) * dw * xh;
-        // Collision direction d_n = t_i x t_j. Near-colinear hairs: the paper prints
-        // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is
-        // t_i, i.e. ALONG the hair, contradicting "normal to the hair directions". We use the
-        // part of x^_ij normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which the case needs.
-        Vec3 dn = ti.cross(s.t[j]);
-        double dn2 = dn.squaredNorm();
-        if (dn2 < eps2) {
-          dn = xh - xh.dot(ti) * ti;
-          dn2 = dn.squaredNorm();
-        }
-        if (dn2 >= 1e-18) {
-          const Vec3 dh = dn / std::sqrt(dn2);
-          const Vec3 vab = s.v[j] - vi;
-          // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one
-          // setting works for any particle count: d_c(paper) = d_c mu / W(h, 0).
-          const double muw = mi * mj / (mi + mj) * (w * inv_w0);
-          const double vn = vab.dot(dh);
-          if (vn * xab.dot(dh) < 0) f += p.collision_damping * muw * vn * dh;  // (3.17)
-          f += p.friction_damping * muw * (vab - vn * dh);  // (3.18) d_f W (v_ij . d^_t) d^_t
-        }
-        ws.pair_f[e] = f;
-      }
-    });
+    parallel_for(ctx, 0, n, [&](std::size_t i) { hair_pairs_of(i, s, ws, K, inv_w0); });
   }
-  // Gather per particle in a fixed order (adjacency, then neighbour list): deterministic for
-  // any thread count, and each pair's two contributions are exact negations.
-  parallel_for(ctx, 0, n, [&](std::size_t i) {
-    Vec3 f = Vec3::Zero();
-    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
-      const uint32_t q = m.adj_pairs[e];
-      if (m.pair_a[q] == i)
-        f += ws.spring_f[q];
-      else
-        f -= ws.spring_f[q];
+  parallel_for(ctx, 0, n, [&](std::size_t i) { ws.force[i] = gather_of(i, ws, hh); });
+}
+
+void LcpSolver::direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws,
+                             bool cached) const {
+  const auto& m = m_model;
+  if (m.root[i]) return;
+  Vec3 acc = Vec3::Zero();
+  const Vec3 ti = s.t[i];
+  for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
+    const uint32_t q = m.adj_pairs[e];
+    const bool is_a = m.pair_a[q] == i;
+    double r;
+    Vec3 xh;  // x^_ij
+    if (cached) {
+      // x_ji = -x_ij exactly, so the shared geometry serves both ends bit for bit.
+      r = ws.conn_r[q];
+      if (r <= 0) continue;
+      xh = is_a ? ws.conn_xh[q] : Vec3(-ws.conn_xh[q]);
+    } else {
+      const uint32_t j = is_a ? m.pair_b[q] : m.pair_a[q];
+      const Vec3 d = s.x[j] - s.x[i];
+      r = d.norm();
+      if (r <= 0) continue;
+      xh = d / r;
     }
-    if (hh)
-      for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-        if (ws.nbrs[e] > i)
-          f += ws.pair_f[e];
-        else
-          f -= ws.pair_f[ws.nbr_mirror[e]];
-      }
-    ws.force[i] = f;
-  });
+    const double c0 = is_a ? m.cos_a[q] : -m.cos_b[q];  // cos theta0_ij against x_ij
+    const double s0 = is_a ? m_sin_a[q] : m_sin_b[q];   // sin theta0_ij
+    Vec3 perp = ti - ti.dot(xh) * xh;
+    const double pn = perp.norm();
+    // t_i^j: x^_ij rotated by theta0_ij about the axis normal to t_i and x_ij (Fig. 3.3 c).
+    const Vec3 tij = pn > 1e-12 ? Vec3(c0 * xh + s0 * perp / pn) : Vec3(c0 * xh);
+    acc += ws.alpha[q] * ws.k[q] * tij;  // (3.15)
+  }
+  const double an = acc.norm();
+  if (an > 1e-300 && std::isfinite(an)) s.t[i] = acc / an;
 }
 
 void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWorkspace& ws) const {
-  const auto& m = m_model;
-  parallel_for(ctx, 0, m.size(), [&](std::size_t i) {
-    if (m.root[i]) return;
-    Vec3 acc = Vec3::Zero();
-    const Vec3 ti = s.t[i];
-    for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
-      const uint32_t q = m.adj_pairs[e];
-      const bool is_a = m.pair_a[q] == i;
-      const uint32_t j = is_a ? m.pair_b[q] : m.pair_a[q];
-      const Vec3 d = s.x[j] - s.x[i];
-      const double r = d.norm();
-      if (r <= 0) continue;
-      const Vec3 xh = d / r;                              // x^_ij
-      const double c0 = is_a ? m.cos_a[q] : -m.cos_b[q];  // cos theta0_ij against x_ij
-      const double s0 = is_a ? m_sin_a[q] : m_sin_b[q];   // sin theta0_ij
-      Vec3 perp = ti - ti.dot(xh) * xh;
-      const double pn = perp.norm();
-      // t_i^j: x^_ij rotated by theta0_ij about the axis normal to t_i and x_ij (Fig. 3.3 c).
-      const Vec3 tij = pn > 1e-12 ? Vec3(c0 * xh + s0 * perp / pn) : Vec3(c0 * xh);
-      acc += ws.alpha[q] * ws.k[q] * tij;  // (3.15)
-    }
-    const double an = acc.norm();
-    if (an > 1e-300 && std::isfinite(an)) s.t[i] = acc / an;
-  });
+  parallel_for(ctx, 0, m_model.size(), [&](std::size_t i) { direction_of(i, s, ws, false); });
 }
 
 LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpState& s,
                               LcpWorkspace& ws) const {
   LcpStepReport rep;
   const auto& m = m_model;
-  const std::size_t n = m.size();
+  const auto& P = m_params;
+  const std::size_t n = m.size(), np = m.num_pairs();
   if (s.x.size() != n || s.v.size() != n || s.t.size() != n) {
     rep.ok = false;
     rep.message = fmt::format("state has {} particles, model {}", s.x.size(), n);
@@ -775,11 +830,37 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     rep.message = "external force array size differs from the particle count";
     return rep;
   }
+  ws.k.resize(np);
+  ws.alpha.resize(np);
+  ws.alpha_r.resize(n);
+  ws.alpha_t.resize(n);
+  ws.spring_f.resize(np);
+  ws.force.resize(n);
+  ws.density.resize(n);
+  ws.pressure.resize(n);
+  ws.p_rho2.resize(n);
+  // Connection geometry: still valid when the positions are those it was computed from.
+  const bool geom_valid = ws.geom_owner == this && ws.conn_r.size() == np &&
+                          ws.conn_xh.size() == np && ws.geom_x.size() == n &&
+                          std::memcmp(ws.geom_x.data(), s.x.data(), n * sizeof(Vec3)) == 0;
+  ws.conn_r.resize(np);
+  ws.conn_xh.resize(np);
+  ws.geom_owner = nullptr;  // set again below once it matches s.x
+  auto geometry_of = [&](std::size_t i) {
+    for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
+      const uint32_t q = m_rs_pairs[e];
+      const Vec3 d = s.x[i] - s.x[m.pair_a[q]];  // x_ab, b = i
+      const double r = d.norm();
+      ws.conn_r[q] = r;
+      ws.conn_xh[q] = d / r;
+    }
+  };
+  if (!geom_valid) parallel_for(ctx, 0, n, geometry_of);
   // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
   // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
-  int nsub = m_params.substeps;
+  int nsub = P.substeps;
   bool alpha_fresh = false;  // ws.k/ws.alpha already hold the values for the current positions
-  if (m_params.cfl > 0) {
+  if (P.cfl > 0) {
     solve_alpha(ctx, s, ws);
     alpha_fresh = true;
     const double w2 = deterministic_reduce(
@@ -797,16 +878,14 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
         [](double a, double b) { return std::max(a, b); });
     // The explicit hair-hair damping (3.17)/(3.18) needs d dt < 1 as well (per reduced mass).
     const double rate = std::max(
-        std::sqrt(w2),
-        m_params.hair_hair ? std::max(m_params.collision_damping, m_params.friction_damping) : 0.0);
-    const double need = std::ceil(in.dt * rate / m_params.cfl);
-    if (std::isfinite(need))
-      nsub = std::max(nsub, int(std::min<double>(need, m_params.max_substeps)));
+        std::sqrt(w2), P.hair_hair ? std::max(P.collision_damping, P.friction_damping) : 0.0);
+    const double need = std::ceil(in.dt * rate / P.cfl);
+    if (std::isfinite(need)) nsub = std::max(nsub, int(std::min<double>(need, P.max_substeps)));
   }
   const double dt = in.dt / nsub;
   const anim::RigidSample& hd = in.head;
   const Mat3 R = hd.rotation, Rt = R.transpose();
-  const Vec3 g_h = Rt * m_params.gravity;
+  const Vec3 g_h = Rt * P.gravity;
   // Inertial (fictitious) accelerations of the head frame, in head coordinates.
   const Vec3 A_h = Rt * hd.acceleration, w_h = Rt * hd.angular_velocity,
              al_h = Rt * hd.angular_acceleration, V_h = Rt * hd.velocity;
@@ -814,18 +893,85 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.accel.resize(n);
   ws.contact.assign(n, 0);
   ws.penetration.assign(n, 0.0);
+  const std::size_t nchunks = (n + kChunk - 1) / kChunk;
+  ws.chunk_max.resize(nchunks);
+  ws.chunk_check.resize(nchunks);
+  const double h = m.h, r2max = 4 * h * h;
+  const SphKernel K(h);
+  const double w0 = K.w(0.0), inv_w0 = 1.0 / w0;
+  const double skin = P.neighbour_skin * 2 * h;
+  const double Rn = 2 * h + skin;
+  const bool hh = P.hair_hair;
+  if (!hh) {
+    ws.nbr_offsets.clear();
+    ws.nbr_upper.clear();
+  }
   for (int sub = 0; sub < nsub; ++sub) {
-    if (m_params.hair_hair) {
-      neighbours_and_density(ctx, s, ws);
-    } else {
-      ws.nbr_offsets.clear();
-    }
-    if (!alpha_fresh) solve_alpha(ctx, s, ws);
+    const bool do_alpha = !alpha_fresh;
     alpha_fresh = false;
-    pair_forces_sorted(ctx, s, ws);
-    // Accelerations and the leapfrog update in one pass (each particle reads only its own state):
-    // v(t + dt/2) = v(t - dt/2) + a(t) dt, x(t + dt) = x(t) + v(t + dt/2) dt.
+    // 1. k_ij (3.7) from the shared geometry, W per pair, displacement since the list build.
+    bool rebuild = false;
+    if (hh) {
+      rebuild = skin <= 0 || ws.nbr_built_x.size() != n || ws.nbr_radius != Rn ||
+                ws.nbr_offsets.size() != n + 1 || ws.nbr_mirror.size() != ws.nbrs.size();
+      if (rebuild) rebuild_neighbours(ctx, s, ws);
+      if (rebuild || ws.nbr_upper.size() != n)
+        upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
+      ws.pair_w.resize(ws.nbrs.size());
+      ws.pair_f.resize(ws.nbrs.size());
+    }
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
+        double dmax = 0;
+        for (std::size_t i = i0; i < i1; ++i) {
+          if (do_alpha) coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
+          if (!hh) continue;
+          const Vec3 xi = s.x[i];
+          dmax = std::max(dmax, (xi - ws.nbr_built_x[i]).squaredNorm());
+          for (uint32_t e = ws.nbr_upper[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+            const double d2 = (s.x[ws.nbrs[e]] - xi).squaredNorm();
+            ws.pair_w[e] = d2 < r2max ? K.w(std::sqrt(d2)) : 0.0;
+          }
+        }
+        ws.chunk_max[i0 / kChunk] = dmax;
+      });
+      if (!hh || rebuild) break;
+      double d2 = 0;
+      for (double d : ws.chunk_max) d2 = std::max(d2, d);
+      const double lim = 0.49 * skin;
+      if (d2 < lim * lim) break;  // the lists still hold every pair within 2h
+      // Some particle moved more than half the skin: rebuild and redo (also when NaN).
+      rebuild = true;
+      rebuild_neighbours(ctx, s, ws);
+      upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
+      ws.pair_w.resize(ws.nbrs.size());
+      ws.pair_f.resize(ws.nbrs.size());
+    }
+    // 2. alpha sums (3.13), density (3.1) and pressure.
     parallel_for(ctx, 0, n, [&](std::size_t i) {
+      if (do_alpha) alpha_sums_of(i, ws);
+      if (hh) density_of(i, ws, w0);
+    });
+    if (do_alpha && P.alpha_sweeps > 0) {
+      parallel_for(ctx, 0, n, [&](std::size_t i) { alpha_of(i, ws); });
+      alpha_sweeps(ctx, ws);
+    }
+    const bool alpha_here = do_alpha && P.alpha_sweeps == 0;
+    // 3. alpha (3.14), springs and hair-hair forces, once per connection / pair.
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      if (alpha_here) alpha_of(i, ws);
+      for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
+        const uint32_t q = m_rs_pairs[e];
+        spring_of(q, s, ws, ws.conn_r[q], ws.conn_xh[q]);
+      }
+      if (hh) hair_pairs_of(i, s, ws, K, inv_w0);
+    });
+    // 4. Gather, accelerations and the leapfrog update (each particle reads only its own state
+    // besides the per-pair forces): v(t + dt/2) = v(t - dt/2) + a(t) dt, x(t + dt) = x(t) +
+    // v(t + dt/2) dt.
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      const Vec3 force = gather_of(i, ws, hh);
+      ws.force[i] = force;
       if (m.root[i]) {
         ws.accel[i] = Vec3::Zero();
         ws.contact[i] = 0;
@@ -836,17 +982,17 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       }
       const double mi = m.mass[i];
       const Vec3 r = s.x[i] - piv;  // head-frame lever arm about the pivot
-      Vec3 a = ws.force[i] / mi + g_h;
+      Vec3 a = force / mi + g_h;
       // Inertial forces due to head movement (§3.6).
       a -= A_h + al_h.cross(r) + w_h.cross(w_h.cross(r)) + 2.0 * w_h.cross(s.v[i]);
       // Air friction against still air: world velocity = V + omega x r + v.
-      a -= m_params.air_drag * (V_h + w_h.cross(r) + s.v[i]);
+      a -= P.air_drag * (V_h + w_h.cross(r) + s.v[i]);
       if (in.external_force) a += Rt * (*in.external_force)[i] / mi;
       uint8_t c = 0;
       double pdepth = 0;
-      if (m_params.body_collision && m_body) {
+      if (P.body_collision && m_body) {
         if (const sim::BodyPlane* pl = m_body->find(s.x[i])) {
-          const Vec3 ac = sim::body_contact_accel(*pl, s.x[i], s.v[i], a, dt, m_params.contact);
+          const Vec3 ac = sim::body_contact_accel(*pl, s.x[i], s.v[i], a, dt, P.contact);
           if (ac.squaredNorm() > 0) c = 1;
           a += ac;
           pdepth = std::max(0.0, -(s.x[i] - pl->p).dot(pl->n));
@@ -858,33 +1004,30 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       s.v[i] += a * dt;
       s.x[i] += s.v[i] * dt;
     });
-    update_directions(ctx, s, ws);
+    // 5. Connection geometry at the new positions.
+    parallel_for(ctx, 0, n, geometry_of);
+    // 6. Directions (3.15) and the blow-up check: first non-finite or too fast particle, in
+    // index order.
+    const double vlim = P.max_speed;
+    parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
+      LcpWorkspace::ChunkCheck c;
+      for (std::size_t i = i0; i < i1; ++i) {
+        direction_of(i, s, ws, true);
+        const double sp = s.v[i].norm();
+        const bool bad =
+            !std::isfinite(sp) || !s.x[i].allFinite() || !s.t[i].allFinite() || sp > vlim;
+        if (bad && c.bad == SIZE_MAX) c.bad = i;
+        if (std::isfinite(sp)) c.vmax = std::max(c.vmax, sp);
+      }
+      ws.chunk_check[i0 / kChunk] = c;
+    });
     s.time += dt;
     rep.substeps = sub + 1;
-    // Blow-up detection: first non-finite or too fast particle, in index order.
-    struct Chk {
-      double vmax = 0;
-      std::size_t bad = SIZE_MAX;
-    };
-    const double vlim = m_params.max_speed;
-    const Chk chk = deterministic_reduce(
-        ctx, n, 1024, Chk{},
-        [&](std::size_t i0, std::size_t i1) {
-          Chk c;
-          for (std::size_t i = i0; i < i1; ++i) {
-            const double sp = s.v[i].norm();
-            const bool bad =
-                !std::isfinite(sp) || !s.x[i].allFinite() || !s.t[i].allFinite() || sp > vlim;
-            if (bad && c.bad == SIZE_MAX) c.bad = i;
-            if (std::isfinite(sp)) c.vmax = std::max(c.vmax, sp);
-          }
-          return c;
-        },
-        [](Chk acc, const Chk& part) {
-          acc.vmax = std::max(acc.vmax, part.vmax);
-          if (acc.bad == SIZE_MAX) acc.bad = part.bad;
-          return acc;
-        });
+    LcpWorkspace::ChunkCheck chk;
+    for (const auto& part : ws.chunk_check) {
+      chk.vmax = std::max(chk.vmax, part.vmax);
+      if (chk.bad == SIZE_MAX) chk.bad = part.bad;
+    }
     rep.max_speed = chk.vmax;
     if (chk.bad != SIZE_MAX) {
       const double sp = s.v[chk.bad].norm();
@@ -899,6 +1042,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       return rep;
     }
   }
+  ws.geom_x = s.x;
+  ws.geom_owner = this;
   rep.num_contacts = std::size_t(std::count(ws.contact.begin(), ws.contact.end(), uint8_t(1)));
   for (double d : ws.penetration) rep.max_penetration = std::max(rep.max_penetration, d);
   return rep;

@@ -17,6 +17,7 @@
 #include "follicle/core/types.hpp"
 #include "follicle/hair/particle_grid.hpp"
 #include "follicle/hair/scalp_bando2003.hpp"
+#include "follicle/hair/sph_kernel.hpp"
 #include "follicle/sim/step_report.hpp"
 #include "follicle/sim/voxel_planes.hpp"
 
@@ -182,6 +183,22 @@ struct LcpWorkspace {
   std::vector<double> p_rho2;        // P_i / rho_i^2 per particle
   std::vector<uint8_t> contact;      // per particle, last sub-step
   std::vector<double> penetration;   // per particle, last sub-step [m]
+  // First entry of each neighbour list with a higher index (the lists are sorted): the pairs a
+  // particle evaluates itself.
+  std::vector<uint32_t> nbr_upper;
+  // Connection geometry at the positions geom_x: |x_ab| and x^_ab = x_ab / |x_ab| per connection
+  // (x_ab = x_b - x_a). Shared by k_ij (3.7), the spring forces and the direction update (3.15)
+  // of both ends; reused by the next step() when the positions are bit-identical.
+  std::vector<double> conn_r;
+  std::vector<Vec3> conn_xh;
+  std::vector<Vec3> geom_x;
+  const void* geom_owner = nullptr;  // the solver that computed conn_r / conn_xh
+  std::vector<double> chunk_max;     // per-chunk reduction scratch
+  struct ChunkCheck {
+    double vmax = 0;
+    std::size_t bad = SIZE_MAX;
+  };
+  std::vector<ChunkCheck> chunk_check;
 };
 
 /// Builds the connections (§3.3.1, (3.5)-(3.6), pruning by a0 and N_n) for given particles.
@@ -243,8 +260,22 @@ class LcpSolver {
   double rho0() const { return m_rho0; }
 
  private:
-  void neighbours_and_density(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  void rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
   void pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  // Per-particle pieces shared by the public functions and the fused sub-step of step().
+  template <class R>
+  void coefficients_of(std::size_t i, const LcpState& s, LcpWorkspace& ws, R&& r_of) const;
+  void alpha_sums_of(std::size_t i, LcpWorkspace& ws) const;
+  void alpha_of(std::size_t i, LcpWorkspace& ws) const;
+  void alpha_sweeps(const Context& ctx, LcpWorkspace& ws) const;
+  void spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, double r,
+                 const Vec3& xh) const;
+  void hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws, const SphKernel& K,
+                     double inv_w0) const;
+  Vec3 gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const;
+  void direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws, bool cached) const;
+  void density_of(std::size_t i, LcpWorkspace& ws, double w0) const;
+  std::vector<uint32_t> m_rs_offsets, m_rs_pairs;  // tip-side particle -> its root-side connections
   LcpParams m_params;
   std::vector<double> m_ea;              // E A_i per particle ((3.9) with the constant modulus)
   std::vector<double> m_sin_a, m_sin_b;  // sin theta0 per connection end (for (3.15))

@@ -7,6 +7,43 @@
 
 namespace follicle::hair {
 
+void ParticleGrid::build(const Context& ctx, const std::vector<Vec3>& points, double cell) {
+  if (ctx.threads() == 1 || points.size() < 4096) {
+    build(points, cell);
+    return;
+  }
+  if (!(cell > 0) || !std::isfinite(cell)) fail("particle grid: cell size {} must be > 0", cell);
+  m_inv = 1.0 / cell;
+  std::size_t nb = 64;
+  while (nb < 2 * points.size()) nb *= 2;
+  m_mask = uint32_t(nb - 1);
+  const std::size_t n = points.size();
+  m_bucket_of.resize(n);
+  m_cell_of.resize(n);
+  parallel_for(
+      ctx, 0, n,
+      [&](std::size_t i) {
+        const Vec3& p = points[i];
+        const std::array<int, 3> c{int(std::floor(p.x() * m_inv)), int(std::floor(p.y() * m_inv)),
+                                   int(std::floor(p.z() * m_inv))};
+        m_cell_of[i] = c;
+        m_bucket_of[i] = bucket(c[0], c[1], c[2]);
+      },
+      2048);
+  // Counting sort by bucket, stable by index (the serial build's order).
+  m_start.assign(nb + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++m_start[m_bucket_of[i] + 1];
+  for (std::size_t b = 0; b < nb; ++b) m_start[b + 1] += m_start[b];
+  m_sorted.resize(n);
+  m_cell_sorted.resize(n);
+  m_fill.assign(m_start.begin(), m_start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const uint32_t slot = m_fill[m_bucket_of[i]]++;
+    m_sorted[slot] = uint32_t(i);
+    m_cell_sorted[slot] = m_cell_of[i];
+  }
+}
+
 void ParticleGrid::build(const std::vector<Vec3>& points, double cell) {
   if (!(cell > 0) || !std::isfinite(cell)) fail("particle grid: cell size {} must be > 0", cell);
   m_inv = 1.0 / cell;

@@ -18,6 +18,8 @@ class ParticleGrid {
  public:
   /// Buckets `points` into cells of edge `cell` [m].
   void build(const std::vector<Vec3>& points, double cell);
+  /// The same grid (identical order), with the cell and bucket computation in parallel.
+  void build(const Context& ctx, const std::vector<Vec3>& points, double cell);
 
   /// Calls f(j) for every point j in the 27 cells around p (a superset of the points within
   /// `cell` of p; hash collisions may add far points, callers test the distance). Order is fixed.
@@ -62,6 +64,8 @@ class ParticleGrid {
   std::vector<uint32_t> m_sorted;  // point indices by bucket
   std::vector<uint32_t> m_bucket_of;
   std::vector<std::array<int, 3>> m_cell_sorted;  // integer cell of each sorted point
+  std::vector<std::array<int, 3>> m_cell_of;      // scratch of the parallel build
+  std::vector<uint32_t> m_fill;                   // scratch of the parallel build
 };
 
 /// Sorts each CSR list by neighbour index and fills mirror[e] with the entry (j -> i) of every

@@ -94,11 +94,14 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     rep.message = "sph_air: hair arrays differ in size or dt is not > 0";
     return rep;
   }
-  if (force_on_hair) force_on_hair->assign(nh, Vec3::Zero());
+  if (force_on_hair) force_on_hair->resize(nh);
   const double rc = m_p.coupling_radius, wc0 = sph_w(rc / 2, 0.0);
   const double h = m_h, cs = std::sqrt(m_p.k_p);
-  std::vector<Vec3> impulse(nh, Vec3::Zero());
-  if (nh) m_hair_grid.build(hair_x, rc);
+  std::vector<Vec3>& impulse = m_impulse;
+  impulse.resize(nh);
+  parallel_for(
+      ctx, 0, nh, [&](std::size_t i) { impulse[i] = Vec3::Zero(); }, 4096);
+  if (nh) m_hair_grid.build(ctx, hair_x, rc);
   double t = 0;
   int guard = 0;
   while (t < dt - 1e-12 && guard++ < 100000) {
@@ -110,7 +113,7 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     sub = std::min(sub, dt - t);
     // Air-air: density (3.1) and pressure (no tension).
     const double cell = std::max(2 * h, rc);
-    m_grid.build(m_x, cell);
+    m_grid.build(ctx, m_x, cell);
     m_grid.neighbour_lists(ctx, m_x, 2 * h, m_off, m_nb);
     m_rho.resize(n);
     m_pr.resize(n);
@@ -190,6 +193,7 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
       ++k;
     }
     if (!rep.ok) {
+      if (force_on_hair) force_on_hair->assign(nh, Vec3::Zero());
       rep.finish("sph_air", m_p.max_speed);
       return rep;
     }
@@ -202,7 +206,8 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     }
   }
   if (force_on_hair)
-    for (std::size_t i = 0; i < nh; ++i) (*force_on_hair)[i] = impulse[i] / dt;
+    parallel_for(
+        ctx, 0, nh, [&](std::size_t i) { (*force_on_hair)[i] = impulse[i] / dt; }, 4096);
   return rep;
 }
 

@@ -92,6 +92,7 @@ class SphAir {
   std::vector<uint32_t> m_off, m_nb, m_hoff, m_hnb, m_aoff, m_anb;
   std::vector<double> m_rho, m_pr;
   std::vector<Vec3> m_acc, m_drag;  // m_drag: air-hair drag on the hair per air-list entry
+  std::vector<Vec3> m_impulse;      // drag impulse on each hair particle over a step
   std::vector<uint32_t> m_fill;
 };
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <map>
 #include <memory>
@@ -81,7 +82,8 @@ class BigBuffer {
  public:
   BigBuffer(std::size_t n, T fill) : m_n(n) {
     constexpr std::size_t kHuge = std::size_t(2) << 20;
-    const std::size_t bytes = std::max<std::size_t>(kHuge, (n * sizeof(T) + kHuge - 1) / kHuge * kHuge);
+    const std::size_t bytes =
+        std::max<std::size_t>(kHuge, (n * sizeof(T) + kHuge - 1) / kHuge * kHuge);
     m_p.reset(static_cast<T*>(std::aligned_alloc(kHuge, bytes)));
     if (!m_p) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
@@ -89,11 +91,21 @@ class BigBuffer {
 #endif
     std::fill(m_p.get(), m_p.get() + n, fill);
   }
-  T* data() { return m_p.get(); }
-  const T* data() const { return m_p.get(); }
-  std::size_t size() const { return m_n; }
-  T& operator[](std::size_t i) { return m_p.get()[i]; }
-  const T& operator[](std::size_t i) const { return m_p.get()[i]; }
+  T* data() {
+    return m_p.get();
+  }
+  const T* data() const {
+    return m_p.get();
+  }
+  std::size_t size() const {
+    return m_n;
+  }
+  T& operator[](std::size_t i) {
+    return m_p.get()[i];
+  }
+  const T& operator[](std::size_t i) const {
+    return m_p.get()[i];
+  }
 
  private:
   struct Free {
@@ -170,6 +182,7 @@ bool visit_segment(int w, int h, const Vec2& a, const Vec2& b, double width, con
   const double l2 = ab.squaredNorm();
   // Coverage needs d < r + 0.5; rows and columns are bounded with one more texel of margin.
   const double R = r + 1.5;
+  const double out2 = (r + 0.5 + 1e-6) * (r + 0.5 + 1e-6);
   for (int y = by0; y <= by1; ++y) {
     const double yc = y + 0.5;
     // x extent of the part of the segment within R of the row's centre line.
@@ -198,7 +211,9 @@ bool visit_segment(int w, int h, const Vec2& a, const Vec2& b, double width, con
       const Vec2 p(x + 0.5, yc);
       double t = l2 > 0 ? (p - a).dot(ab) / l2 : 0.0;
       t = std::clamp(t, 0.0, 1.0);
-      const double d = (p - (a + t * ab)).norm();
+      const double d2 = (p - (a + t * ab)).squaredNorm();
+      if (d2 >= out2) continue;  // d >= r + 0.5: no coverage (skips the square root)
+      const double d = std::sqrt(d2);
       const double cov = std::clamp(0.5 + r - d, 0.0, 1.0);
       if (cov > 0) f(rowi + std::size_t(x), cov);
     }
@@ -473,10 +488,11 @@ class Carver {
   /// Generates one furrow from P0 (both directions); false when nothing was carved.
   bool furrow(const Vec2& P0, int id) {
     Rng rng = Rng::stream(m_seed, uint64_t(id));
-    std::array<std::vector<Vec2>, 2> halves;
+    auto& halves = m_halves;  // reused between furrows (no allocation per furrow)
     for (int side = 0; side < 2; ++side) {
       const double sign = side == 0 ? 1.0 : -1.0;  // the opposite field d -> -d
       std::vector<Vec2>& pts = halves[side];
+      pts.clear();
       pts.push_back(P0);
       Vec2 P = P0;
       long n = std::numeric_limits<long>::max();  // n initialized to infinity
@@ -507,7 +523,7 @@ class Carver {
               hgt[i] = hgt[i] + cf * (std::min(hgt[i], I) - hgt[i]);
             }))
           image::draw_line(m_out.height, P, Q, fp.Wh * m_unit, I, image::Blend::Min);  // throws
-                                                                                   // the error
+                                                                                       // the error
         // step 6: record PQ on the occupancy image with value 1 and width W_o (Blend::Max of
         // the coverage; only whether it reaches 0.5 matters, see the constructor)
         mark_segment(sz, P, Q, fp.Wo * m_unit, m_occ.data());
@@ -537,8 +553,9 @@ class Carver {
   HeightField& m_out;
   const SeamInit* m_init;
   SegmentGrid m_grid;
-  BigBuffer<float> m_h;      // the height image while carving
-  BigBuffer<uint8_t> m_occ;  // occupancy: 1 = occupied (see the constructor)
+  BigBuffer<float> m_h;                       // the height image while carving
+  BigBuffer<uint8_t> m_occ;                   // occupancy: 1 = occupied (see the constructor)
+  std::array<std::vector<Vec2>, 2> m_halves;  // the two halves of the current furrow
 };
 
 }  // namespace
@@ -602,21 +619,28 @@ FineWrinkles generate_fine_wrinkles(const Context& ctx, const geom::TriMesh& mes
   w.unit_texels = resolve_unit_texels(p, w.texels);
   w.depth_m = p.depth_m;
   w.r = p.r;
-  std::array<std::vector<Vec2>, 2> dirs;
-  for (int k = 0; k < 2; ++k) {
-    std::vector<DirectionKey> all = keys[k];
-    if (seams[k]) all.insert(all.end(), seams[k]->directions.begin(), seams[k]->directions.end());
-    dirs[k] = interpolate_direction_field(mesh, all, fmt::format("fine_wrinkles.fields[{}]", k));
-  }
-  // The two fields are independent: one task each.
+  // The two fields are independent: one task each (direction field (§2.6.1) and carving).
+  // A bad key of field 0 is reported before one of field 1, whichever task fails first.
+  std::array<std::exception_ptr, 2> errors;
   parallel_for(
       ctx, 0, 2,
       [&](std::size_t k) {
-        w.fields[k] =
-            carve_furrows(mesh, w.texels, dirs[k], w.unit_texels, p,
-                          Rng::stream(ctx.seed(), 0xF1E1D000ULL + k).next_u64(), seams[k]);
+        try {
+          std::vector<DirectionKey> all = keys[k];
+          if (seams[k])
+            all.insert(all.end(), seams[k]->directions.begin(), seams[k]->directions.end());
+          std::vector<Vec2> dirs =
+              interpolate_direction_field(mesh, all, fmt::format("fine_wrinkles.fields[{}]", k));
+          w.fields[k] =
+              carve_furrows(mesh, w.texels, std::move(dirs), w.unit_texels, p,
+                            Rng::stream(ctx.seed(), 0xF1E1D000ULL + k).next_u64(), seams[k]);
+        } catch (...) {
+          errors[k] = std::current_exception();
+        }
       },
       1);
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
   return w;
 }
 
