@@ -13,11 +13,19 @@ fail() { echo "FAIL $*"; fails=$((fails + 1)); }
 # small SCENE OUT FRAMES: few particles, a small image, FRAMES frames.
 small() {
   python3 - "$ROOT/data/scenes/$1.json" "$2" "$3" <<'PY'
-import json, sys
+import json, os, sys
 src, out, frames = sys.argv[1], sys.argv[2], int(sys.argv[3])
 s = json.load(open(src))
+# The copy lives elsewhere: asset paths (relative to the scene file) become absolute.
+base = os.path.dirname(os.path.abspath(src))
+for m in s.get("assets", {}).get("meshes", []):
+    m["path"] = os.path.normpath(os.path.join(base, m["path"]))
+    mat = m.get("material", {})
+    if "texture" in mat:
+        mat["texture"] = os.path.normpath(os.path.join(base, mat["texture"]))
 sc = s["lcp"]["scenario"]
 sc["spacing"] = 0.02
+sc["settle_time"] = 0.1
 if sc.get("wind"):
     sc["air_spacing"] = 0.04
 s["render"].update(width=96, height=96, supersample=1)

@@ -1,6 +1,9 @@
 #include "follicle/hair/lcp_scenario_bando2003.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include "follicle/core/error.hpp"
 
 namespace follicle::hair {
 
@@ -29,50 +32,128 @@ geom::TriMesh lcp_sphere_mesh(double radius, int nlat, int nlon) {
   return m;
 }
 
-LcpScenario::LcpScenario(const Context& ctx, const LcpScenarioParams& params, const LcpParams& lcp)
+geom::TriMesh lcp_box_mesh(const Vec3& centre, const Vec3& half_extents) {
+  geom::TriMesh m;
+  for (int k = 0; k < 8; ++k)
+    m.positions.push_back(centre + Vec3((k & 1) ? half_extents.x() : -half_extents.x(),
+                                        (k & 2) ? half_extents.y() : -half_extents.y(),
+                                        (k & 4) ? half_extents.z() : -half_extents.z()));
+  // Two triangles per side, counter-clockwise seen from outside.
+  const int quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& q : quads) {
+    m.faces.push_back({q[0], q[1], q[2]});
+    m.faces.push_back({q[0], q[2], q[3]});
+  }
+  m.compute_normals();
+  return m;
+}
+
+LcpScenario::LcpScenario(const Context& ctx, const LcpScenarioParams& params, const LcpParams& lcp,
+                         const geom::TriMesh* head_mesh, const image::ImageF* length_map)
     : m_p(params) {
   m_p.validate();
   const double R = m_p.head_radius;
-  m_head = lcp_sphere_mesh(R);
   auto P = [R](double polar, double az) -> Vec3 {
     return R *
            Vec3(std::sin(polar) * std::cos(az), std::cos(polar), -std::sin(polar) * std::sin(az));
   };
   ScalpCurves curves;
-  const double p0 = 0.3, p1 = 1.9, a0 = 0.35 * kPi, a1 = 0.65 * kPi;
-  for (int i = 0; i <= 4; ++i) {
-    curves[0].push_back(P(p1, a0 + (a1 - a0) * i / 4));
-    curves[1].push_back(P(p1 + (p0 - p1) * i / 4, a1));
-    curves[2].push_back(P(p0, a1 + (a0 - a1) * i / 4));
-    curves[3].push_back(P(p0 + (p1 - p0) * i / 4, a0));
+  Vec3 whirl;
+  if (head_mesh) {
+    head_mesh->check("lcp head mesh");
+    m_head = *head_mesh;
+    if (!m_head.has_normals()) m_head.compute_normals();
+    m_mesh_head = true;
+    const LcpMeshHeadParams& mh = m_p.mesh_head;
+    curves = {mh.curve0, mh.curve1, mh.curve2, mh.curve3};
+    for (int k = 0; k < 4; ++k) {
+      const auto& a = curves[k];
+      const auto& b = curves[(k + 1) % 4];
+      if (a.size() >= 2 && !b.empty() && (a.back() - b.front()).norm() > 1e-3)
+        fail_at(fmt::format("mesh_head.curve{}", k),
+                "ends at ({:.4f}, {:.4f}, {:.4f}) but curve{} starts at ({:.4f}, {:.4f}, {:.4f}); "
+                "the four curves must form a closed loop",
+                a.back().x(), a.back().y(), a.back().z(), (k + 1) % 4, b.front().x(), b.front().y(),
+                b.front().z());
+    }
+    whirl = mh.whirl_point;
+    if (mh.torso) m_torso = lcp_box_mesh(mh.torso_centre, mh.torso_half_extents);
+  } else {
+    m_head = lcp_sphere_mesh(R);
+    const double p0 = 0.3, p1 = 1.9, a0 = 0.35 * kPi, a1 = 0.65 * kPi;
+    for (int i = 0; i <= 4; ++i) {
+      curves[0].push_back(P(p1, a0 + (a1 - a0) * i / 4));
+      curves[1].push_back(P(p1 + (p0 - p1) * i / 4, a1));
+      curves[2].push_back(P(p0, a1 + (a0 - a1) * i / 4));
+      curves[3].push_back(P(p0 + (p1 - p0) * i / 4, a0));
+    }
+    whirl = P(0.3, kPi / 2);
   }
   ScalpParams sp;
   sp.max_length = m_p.hair_length;
   sp.root_depth = std::max(sp.root_depth, m_p.spacing);
   m_scalp = Scalp::trim(m_head, curves, sp);
+  if (length_map && !length_map->empty()) m_scalp.set_length_map(*length_map);
   sim::VoxelPlanesParams vp;
   vp.voxel_size = std::max(0.01, m_p.spacing);
-  m_body = std::make_unique<sim::VoxelPlanes>(sim::VoxelPlanes::build({&m_head}, vp, 3));
+  std::vector<const geom::TriMesh*> body{&m_head};
+  if (!m_torso.faces.empty()) body.push_back(&m_torso);
+  m_body = std::make_unique<sim::VoxelPlanes>(sim::VoxelPlanes::build(body, vp, 3));
   LcpInitParams ip;
   ip.spacing = m_p.spacing;
   ip.total_mass = m_p.total_mass;
-  ip.whirl_point = P(0.3, kPi / 2);
+  ip.whirl_point = whirl;
+  ip.w_n = m_p.root_normal_weight;
+  ip.cantilever_sag = m_p.cantilever_sag;
   LcpInit init = initialize_lcp(ctx, m_scalp, ip, m_body.get());
   m_solver = std::make_unique<LcpSolver>(lcp, std::move(init.model), m_body.get());
   m_state = std::move(init.state);
+  if (m_p.settle_time > 0) settle(ctx, lcp);
+  const Vec3 pivot = m_mesh_head ? m_p.mesh_head.pivot : Vec3::Zero();
   if (m_p.shake) {
     const int cycles = 1000;
-    m_track = anim::RigidMotionTrack::shake(Vec3::Zero(), Vec3::UnitY(), m_p.shake_angle, cycles,
-                                            0.0, cycles * m_p.shake_period);
+    m_track =
+        anim::RigidMotionTrack::shake(pivot, Vec3::UnitY(), m_p.shake_angle, cycles,
+                                      m_p.shake_start, m_p.shake_start + cycles * m_p.shake_period);
   }
   if (m_p.wind) {
     SphAirParams ap;
     ap.spacing = m_p.air_spacing;
     ap.wind_velocity = Vec3(0, 0, -m_p.wind_speed);
-    ap.box_min = Vec3(-0.2, -R - m_p.hair_length - 0.05, -0.4);
-    ap.box_max = Vec3(0.2, 0.05, -0.02);
+    if (m_mesh_head) {
+      // The box around the hanging hair, from the front of the hair's roots (the wind enters
+      // there) to 0.3 m behind the hair, reaching 0.08 m beyond it on the other sides.
+      Eigen::AlignedBox3d hb;
+      for (const auto& x : m_state.x) hb.extend(x);
+      ap.box_min = hb.min() - Vec3(0.08, 0.08, 0.3);
+      ap.box_max = hb.max() + Vec3(0.08, 0.03, 0.0);
+    } else {
+      ap.box_min = Vec3(-0.2, -R - m_p.hair_length - 0.05, -0.4);
+      ap.box_max = Vec3(0.2, 0.05, -0.02);
+    }
     m_air.emplace(ctx, ap);
   }
+}
+
+void LcpScenario::settle(const Context& ctx, const LcpParams& lcp) {
+  // A solver on the same model with extra air drag, the head still and no wind.
+  LcpParams sp = lcp;
+  sp.air_drag = std::max(lcp.air_drag, m_p.settle_drag);
+  const LcpSolver solver(sp, m_solver->model(), m_body.get());
+  const double dt = 1.0 / 120.0;
+  const int steps = std::max(1, int(std::lround(m_p.settle_time / dt)));
+  LcpStepInput in;
+  in.dt = m_p.settle_time / steps;
+  for (int k = 0; k < steps; ++k) {
+    in.head.t = m_state.time;
+    const LcpStepReport r = solver.step(ctx, in, m_state, m_ws);
+    if (!r.ok)
+      fail_at("lcp_scenario.settle_time", "the hair blew up while settling: {}", r.message);
+  }
+  std::fill(m_state.v.begin(), m_state.v.end(), Vec3::Zero());
+  m_state.time = 0;
+  m_ws = LcpWorkspace{};
 }
 
 anim::RigidSample LcpScenario::head_pose() const {

@@ -1,7 +1,9 @@
 #pragma once
 // Ready-made LCP scenes (Bando 2003 §3.6, Figs. 3.7-3.9) for tests, benchmarks and the scene
 // layer: back hair on a head under gravity, optionally a head-shake track and SPH wind. The head
-// is a sphere unless a mesh and scalp curves are given.
+// is a sphere (tests, benchmarks) unless a head mesh is given; then the scalp is trimmed from the
+// mesh by the four Catmull-Rom curves of LcpMeshHeadParams (§3.3.1) and the body's voxel planes
+// (§3.5) are built from area-uniform samples of the mesh and an optional torso box.
 #include <memory>
 #include <optional>
 
@@ -12,21 +14,70 @@
 #include "follicle/hair/lcp_bando2003.hpp"
 #include "follicle/hair/scalp_bando2003.hpp"
 #include "follicle/hair/sph_air_bando2003.hpp"
+#include "follicle/image/image.hpp"
 #include "follicle/sim/voxel_planes.hpp"
 
 namespace follicle::hair {
 
+/// The scalp and body of a mesh head, in the head mesh's frame [m]. The defaults fit the
+/// Lee Perry-Smith head of data/meshes/lee_perry_smith (face towards +z, crown at y ~ 0.185 m,
+/// nape at y ~ 0.01 m): a scalp over the back and top of the head behind the ears, the whirl at
+/// the front of the crown (so the hair is combed back and down) and the shake pivot in the neck.
+struct LcpMeshHeadParams {
+  // Four Catmull-Rom control polygons forming a closed loop (curve k ends where curve k+1 starts):
+  // curve0 -> v = 0 (nape, left to right), curve1 -> u = 1 (right side, up), curve2 -> v = 1
+  // (crown, right to left), curve3 -> u = 0 (left side, down). Points near the mesh surface.
+  std::vector<Vec3> curve0{{0.055, 0.03, -0.062},
+                           {0.03, 0.012, -0.068},
+                           {0.0, 0.008, -0.068},
+                           {-0.03, 0.012, -0.068},
+                           {-0.055, 0.03, -0.062}};
+  std::vector<Vec3> curve1{
+      {-0.055, 0.03, -0.062}, {-0.064, 0.08, -0.06}, {-0.06, 0.13, -0.04}, {-0.045, 0.168, 0.0}};
+  std::vector<Vec3> curve2{{-0.045, 0.168, 0.0}, {0.0, 0.182, 0.03}, {0.045, 0.168, 0.0}};
+  std::vector<Vec3> curve3{
+      {0.045, 0.168, 0.0}, {0.06, 0.13, -0.04}, {0.064, 0.08, -0.06}, {0.055, 0.03, -0.062}};
+  Vec3 whirl_point{0.0, 0.185, 0.06};  // [m] the nearest scalp vertex is the whirl of (3.4)
+  Vec3 pivot{0.0, 0.0, -0.01};         // [m] centre of the head shake (about +y)
+  // A box for the torso below the mesh (collision only, not drawn); the default head mesh already
+  // includes the neck and shoulders down to y = -0.2 m, so the default box is the chest below.
+  bool torso = true;
+  Vec3 torso_centre{0.0, -0.3, -0.01};
+  Vec3 torso_half_extents{0.17, 0.11, 0.1};
+  template <class V>
+  void visit(V&& v) {
+    v("curve0", curve0, ParamInfo{"scalp boundary v = 0 (Catmull-Rom control points)", "m"});
+    v("curve1", curve1, ParamInfo{"scalp boundary u = 1, starts where curve0 ends", "m"});
+    v("curve2", curve2, ParamInfo{"scalp boundary v = 1, starts where curve1 ends", "m"});
+    v("curve3", curve3,
+      ParamInfo{"scalp boundary u = 0, from curve2's end to curve0's start", "m"});
+    v("whirl_point", whirl_point, ParamInfo{"whirl of hair (nearest scalp vertex)", "m", -10, 10});
+    v("pivot", pivot, ParamInfo{"pivot of the head shake", "m", -10, 10});
+    v("torso", torso, ParamInfo{"add a torso box to the collision body"});
+    v("torso_centre", torso_centre, ParamInfo{"torso box centre", "m", -10, 10});
+    v("torso_half_extents", torso_half_extents, ParamInfo{"torso box half extents", "m", 1e-3, 10});
+  }
+};
+
 struct LcpScenarioParams {
-  double head_radius = 0.1;   // [m] sphere head centred at the origin (when no mesh is given)
-  double hair_length = 0.2;   // [m] max hair length
-  double spacing = 0.012;     // [m] Poisson-disc radius (about 2,000 particles at 0.009)
-  double total_mass = 0.05;   // [kg]
-  bool shake = false;         // head shake about +y (Fig. 3.8)
-  double shake_angle = 0.7;   // [rad]
-  double shake_period = 0.5;  // [s] per cycle
-  bool wind = false;          // SPH air (Fig. 3.9)
-  double wind_speed = 3.0;    // [m/s] along -z (blowing from the face towards the back hair)
-  double air_spacing = 0.02;  // [m]
+  double head_radius = 0.1;         // [m] sphere head centred at the origin (when no mesh is given)
+  double hair_length = 0.2;         // [m] max hair length
+  double spacing = 0.012;           // [m] Poisson-disc radius (about 2,000 particles at 0.009)
+  double total_mass = 0.05;         // [kg]
+  bool shake = false;               // head shake about +y (Fig. 3.8)
+  double shake_angle = 0.7;         // [rad]
+  double shake_period = 0.5;        // [s] per cycle
+  bool wind = false;                // SPH air (Fig. 3.9)
+  double wind_speed = 3.0;          // [m/s] along -z (blowing from the face towards the back hair)
+  double air_spacing = 0.02;        // [m]
+  double shake_start = 0.0;         // [s] the shake starts here (the head is still before)
+  double root_normal_weight = 0.6;  // w_n of (3.4) (w_t = 1): how much the roots stand up
+  double cantilever_sag = 800;      // [1/m^3] w/(EI) of the initial cantilever shape
+  // Settling before frame 0: the hair is stepped this long under gravity with the head still,
+  // no wind and air drag settle_drag, then its velocity is zeroed and time restarts at 0.
+  double settle_time = 0.0;     // [s]
+  double settle_drag = 12.0;    // [1/s]
+  LcpMeshHeadParams mesh_head;  // used with a head mesh
   template <class V>
   void visit(V&& v) {
     v("head_radius", head_radius, ParamInfo{"sphere head radius", "m", 1e-3, 10});
@@ -39,6 +90,18 @@ struct LcpScenarioParams {
     v("wind", wind, ParamInfo{"SPH wind"});
     v("wind_speed", wind_speed, ParamInfo{"wind speed", "m/s", 0.01, 100});
     v("air_spacing", air_spacing, ParamInfo{"air particle spacing", "m", 1e-3, 1});
+    v("shake_start", shake_start, ParamInfo{"time the head shake starts", "s", 0, 1e5});
+    v("root_normal_weight", root_normal_weight,
+      ParamInfo{"w_n of (3.4): weight of the scalp normal in the root direction (w_t = 1)", "", 0,
+                100});
+    v("cantilever_sag", cantilever_sag,
+      ParamInfo{"w/(EI) of the initial cantilever hair shape", "1/m^3", 0, 1e9});
+    v("settle_time", settle_time,
+      ParamInfo{"simulated settling under gravity before frame 0 (head still, no wind)", "s", 0,
+                100});
+    v("settle_drag", settle_drag, ParamInfo{"air drag while settling", "1/s", 0, 1e6});
+    v("mesh_head", mesh_head,
+      ParamInfo{"scalp curves, whirl, shake pivot and torso of a mesh head (lcp.mesh)"});
   }
   void validate() const { validate_params(*this, "lcp_scenario"); }
 };
@@ -47,7 +110,12 @@ class LcpScenario {
  public:
   /// Back hair on a sphere head: scalp over the back (polar 0.3..1.9 rad, azimuth 0.35..0.65 pi
   /// about the -z side), whirl at the crown. `lcp` sets the dynamics.
-  LcpScenario(const Context& ctx, const LcpScenarioParams& params, const LcpParams& lcp = {});
+  /// With `head_mesh` (metres, the head frame): the scalp is trimmed from it by
+  /// params.mesh_head's curves and the body is the mesh plus the torso box. `length_map`
+  /// (optional, values in [0, 1], row 0 = v = 1) scales the hair length (§3.3.1).
+  /// Throws follicle::Error (naming the key) on bad curves or parameters.
+  LcpScenario(const Context& ctx, const LcpScenarioParams& params, const LcpParams& lcp = {},
+              const geom::TriMesh* head_mesh = nullptr, const image::ImageF* length_map = nullptr);
 
   /// One frame of dt: wind (if any) first, then the hair with the wind's drag as external force.
   LcpStepReport step(const Context& ctx, double dt);
@@ -56,6 +124,11 @@ class LcpScenario {
   const LcpSolver& solver() const { return *m_solver; }
   const LcpState& state() const { return m_state; }  // head frame
   const geom::TriMesh& head() const { return m_head; }
+  bool mesh_head() const { return m_mesh_head; }
+  /// The collision body (head frame): voxel planes of the head (and torso).
+  const sim::VoxelPlanes& body() const { return *m_body; }
+  /// The torso box mesh (empty without one).
+  const geom::TriMesh& torso() const { return m_torso; }
   const Scalp& scalp() const { return m_scalp; }
   const SphAir* air() const { return m_air ? &*m_air : nullptr; }
   anim::RigidSample head_pose() const;
@@ -64,7 +137,9 @@ class LcpScenario {
 
  private:
   LcpScenarioParams m_p;
-  geom::TriMesh m_head;
+  void settle(const Context& ctx, const LcpParams& lcp);
+  geom::TriMesh m_head, m_torso;
+  bool m_mesh_head = false;
   Scalp m_scalp;
   std::unique_ptr<sim::VoxelPlanes> m_body;
   std::unique_ptr<LcpSolver> m_solver;
@@ -77,5 +152,7 @@ class LcpScenario {
 
 /// A UV sphere mesh (for the default scenario head).
 geom::TriMesh lcp_sphere_mesh(double radius, int nlat = 24, int nlon = 48);
+/// An axis-aligned box mesh (outward normals), e.g. the torso of a mesh head.
+geom::TriMesh lcp_box_mesh(const Vec3& centre, const Vec3& half_extents);
 
 }  // namespace follicle::hair

@@ -80,13 +80,61 @@ Scalp Scalp::trim(const geom::TriMesh& head, const ScalpCurves& curves, const Sc
   std::vector<Vec2> poly;
   for (const auto& x : loop) poly.push_back(proj(x));
 
+  // Faces farther behind the loop's plane than every loop point (by a tenth of the loop's
+  // size) are on the far side of the head.
+  double loop_radius = 0, behind = 0;
+  for (const auto& x : loop) {
+    loop_radius = std::max(loop_radius, (x - c).norm());
+    behind = std::min(behind, (x - c).dot(nrm));
+  }
+  const double min_offset = behind - 0.1 * loop_radius;
   // 3. Faces inside the loop (projected) and facing the loop's side.
   const std::size_t nf = head.faces.size();
   std::vector<char> sel(nf, 0);
   for (std::size_t f = 0; f < nf; ++f) {
     const Vec3i& fc = head.faces[f];
     const Vec3 cen = (head.positions[fc[0]] + head.positions[fc[1]] + head.positions[fc[2]]) / 3;
-    if (head.face_normal(f).dot(nrm) > 0 && inside_polygon(poly, proj(cen))) sel[f] = 1;
+    // Also on the outer side of the loop's plane (the scalp bulges away from the head's centre):
+    // keeps out the far side of the head (mouth, face) that projects into the loop too.
+    if (head.face_normal(f).dot(nrm) > 0 && (cen - c).dot(nrm) > min_offset &&
+        inside_polygon(poly, proj(cen)))
+      sel[f] = 1;
+  }
+  // 3b. On a scan mesh the jagged selection can touch itself at a vertex (a boundary vertex of
+  // degree 4) or leave single unselected faces inside; grow it there (all faces around such a
+  // vertex, every face whose three edges border the selection) until the boundary is manifold.
+  for (int pass = 0; pass < 8; ++pass) {
+    std::map<std::pair<int, int>, int> used;
+    for (std::size_t f = 0; f < nf; ++f)
+      if (sel[f])
+        for (int k = 0; k < 3; ++k) {
+          const int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
+          used[{std::min(a, b), std::max(a, b)}]++;
+        }
+    std::map<int, int> deg;
+    for (const auto& [e, n] : used)
+      if (n == 1) {
+        deg[e.first]++;
+        deg[e.second]++;
+      }
+    std::vector<char> bad(head.positions.size(), 0);
+    bool any = false;
+    for (const auto& [v, d] : deg)
+      if (d != 2) bad[std::size_t(v)] = any = 1;
+    bool grown = false;
+    for (std::size_t f = 0; f < nf; ++f) {
+      if (sel[f]) continue;
+      int bordering = 0;
+      bool at_bad = false;
+      for (int k = 0; k < 3; ++k) {
+        const int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
+        const auto it = used.find({std::min(a, b), std::max(a, b)});
+        if (it != used.end() && it->second == 1) ++bordering;
+        at_bad = at_bad || bad[std::size_t(a)];
+      }
+      if (bordering == 3 || (any && at_bad)) sel[f] = grown = 1;
+    }
+    if (!grown) break;
   }
   // 4. Keep the largest edge-connected component.
   std::map<std::pair<int, int>, std::vector<uint32_t>> edge_faces;

@@ -7,8 +7,8 @@
 
 #include "follicle/geom/strands.hpp"
 #include "follicle/hair/lcp_scenario_bando2003.hpp"
-#include "follicle/sim/voxel_planes.hpp"
 #include "follicle/scene/session.hpp"
+#include "follicle/sim/voxel_planes.hpp"
 #include "follicle/skin/hand_rig.hpp"
 
 namespace follicle::scene {
@@ -33,7 +33,6 @@ class LcpRuntime {
   std::size_t steps = 0;
   // With lcp.part: the scenario's model and state stepped by our own solver, so the parting
   // force can be passed as an external force (LcpScenario::step takes none).
-  std::unique_ptr<sim::VoxelPlanes> body;
   std::unique_ptr<hair::LcpSolver> solver;
   hair::LcpState state;
   std::unique_ptr<hair::LcpWorkspace> ws;

@@ -78,8 +78,9 @@ struct LcpRenderSpec {
     v("opacity", opacity, ParamInfo{"splat opacity alpha (scaled by 1/sin theta)", "", 0.0, 1.0});
     v("splat", splat,
       ParamInfo{"splat shading: Kajiya-Kay + Goldman, billboard shape, self-shadowing"});
-    v("show_head", show_head, ParamInfo{"draw the head the hair grows on"});
-    v("head_color", head_color, ParamInfo{"linear RGB colour of the head", "", 0.0, 1.0});
+    v("show_head", show_head,
+      ParamInfo{"draw the sphere head (a mesh head, lcp.mesh, is drawn as its asset)"});
+    v("head_color", head_color, ParamInfo{"linear RGB colour of the sphere head", "", 0.0, 1.0});
     v("show_air", show_air, ParamInfo{"draw the SPH air particles as small dots (wind)"});
     v("air_radius", air_radius, ParamInfo{"dot radius of an air particle", "m", 1e-5, 1.0});
   }
@@ -107,8 +108,13 @@ struct LcpPartSpec {
 };
 
 /// Loosely connected particle hair on a head (hair::LcpScenario): back hair under gravity,
-/// optionally a head shake and SPH wind. Scene coordinates: the head centre at the origin.
+/// optionally a head shake and SPH wind. Without `mesh` the head is a sphere centred at the
+/// origin; with `mesh` the hair grows on that mesh asset (its transform applied; the scalp,
+/// whirl, shake pivot and torso are scenario.mesh_head, in those scene coordinates) and the mesh
+/// moves with the head shake.
 struct LcpSpec {
+  std::string mesh;        // mesh asset name ("" = sphere head of scenario.head_radius)
+  std::string length_map;  // grayscale image of the hair length over the scalp ("" = uniform)
   hair::LcpScenarioParams scenario;
   hair::LcpParams dynamics;
   int steps_per_frame = 2;
@@ -118,6 +124,11 @@ struct LcpSpec {
 
   template <class V>
   void visit(V&& v) {
+    v("mesh", mesh,
+      ParamInfo{"mesh asset the hair grows on (\"\" = a sphere of scenario.head_radius)"});
+    v("length_map", length_map,
+      ParamInfo{"grayscale PNG/JPEG of the hair length L(u, v) / hair_length over the scalp "
+                "(row 0 = v = 1, the crown; \"\" = uniform), relative to the scene file"});
     v("scenario", scenario,
       ParamInfo{"head, hair length, particle spacing, mass, head shake and wind"});
     v("dynamics", dynamics,

@@ -104,6 +104,14 @@ void Scene::validate(const JsonSource& src) const {
     } catch (const Error& e) {
       json_fail(src, "lcp", e.what());
     }
+    if (!lcp->mesh.empty() && !names.count(lcp->mesh)) {
+      const std::vector<std::string> known(names.begin(), names.end());
+      const std::string hint = suggest(lcp->mesh, known);
+      json_fail(src, "lcp.mesh",
+                "no mesh asset named \"" + lcp->mesh + "\"" +
+                    (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
+                    "; the LCP hair grows on a mesh of assets.meshes with that name");
+    }
   }
   {  // skin_section.cpp
     std::vector<std::string> mesh_names;

@@ -1,5 +1,6 @@
 // Session: loosely connected particle hair (Bando, Chen & Nishita 2003; thesis ch. 3) through
-// hair::LcpScenario (back hair on a sphere head, optional head shake and SPH wind). The
+// hair::LcpScenario (back hair on a mesh head named by lcp.mesh or on a sphere, optional head
+// shake and SPH wind). The
 // simulation starts at frame 0 and advances steps_per_frame steps of 1 / (fps steps_per_frame)
 // per frame; consecutive frames continue from the kept state, an earlier frame restarts from
 // frame 0, so any frame is the same whatever was rendered before it. The particles are drawn as
@@ -7,9 +8,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <optional>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/log.hpp"
+#include "follicle/image/image_io.hpp"
 #include "follicle/scene/hand_runtime.hpp"
 #include "follicle/scene/session.hpp"
 
@@ -26,36 +30,50 @@ std::shared_ptr<const geom::ParticleSet> Session::lcp_particles(int frame) {
   if (!m_lcp) m_lcp = std::make_shared<LcpRuntime>();
   LcpRuntime& rt = *m_lcp;
   if (rt.last && rt.last_frame == frame) return rt.last;
-  if (!rt.ctx)
-    rt.ctx = std::make_unique<Context>(m_ctx->threads(), spec.seed, m_ctx->logger_ptr());
+  if (!rt.ctx) rt.ctx = std::make_unique<Context>(m_ctx->threads(), spec.seed, m_ctx->logger_ptr());
   const Context& ctx = *rt.ctx;
   if (!m_scene.animation && frame > 0)
     fail_at(m_source, "frame {} of a still scene (add an \"animation\" section)", frame);
 
   if (!rt.sim || rt.state_frame > frame) {  // (re)start deterministically at frame 0
+    // A mesh head in scene coordinates at rest (the asset transform applied): the head frame.
+    std::optional<geom::TriMesh> head_mesh;
+    if (!spec.mesh.empty()) {
+      const std::size_t mi = mesh_index(spec.mesh);
+      head_mesh = *mesh(mi);
+      head_mesh->transform(m_scene.assets.meshes[mi].transform.matrix());
+    }
+    image::ImageF length_map;
+    if (!spec.length_map.empty()) {
+      const auto file = resolve(spec.length_map);
+      if (!std::filesystem::is_regular_file(file))
+        fail_at(m_source, "lcp.length_map: image not found: {}", file.string());
+      const image::ImageGray8 g = image::read_png_gray(file);
+      length_map = image::ImageF(g.width(), g.height());
+      for (int y = 0; y < g.height(); ++y)
+        for (int x = 0; x < g.width(); ++x) length_map.at(x, y) = float(g.at(x, y)) / 255.0f;
+    }
     try {
-      rt.sim = std::make_unique<hair::LcpScenario>(ctx, spec.scenario, spec.dynamics);
+      rt.sim = std::make_unique<hair::LcpScenario>(ctx, spec.scenario, spec.dynamics,
+                                                   head_mesh ? &*head_mesh : nullptr,
+                                                   length_map.empty() ? nullptr : &length_map);
     } catch (const Error& e) {
       fail_at(m_source, "lcp: {}", e.what());
     }
     rt.head = std::make_shared<const geom::TriMesh>(rt.sim->head());
     rt.state_frame = 0;
     if (spec.part) {
-      // Same body as LcpScenario (voxel planes of the head, voxel >= the particle spacing).
-      sim::VoxelPlanesParams vp;
-      vp.voxel_size = std::max(0.01, spec.scenario.spacing);
-      rt.body = std::make_unique<sim::VoxelPlanes>(sim::VoxelPlanes::build({rt.head.get()}, vp, 3));
+      // The scenario's body (voxel planes of the head and torso), model and (settled) state.
       rt.solver = std::make_unique<hair::LcpSolver>(spec.dynamics, rt.sim->solver().model(),
-                                                    rt.body.get());
+                                                    &rt.sim->body());
       rt.state = rt.sim->state();
       rt.ws = std::make_unique<hair::LcpWorkspace>();
     }
     ctx.log().info("lcp: {} particles, {} connections", rt.sim->solver().model().size(),
                    rt.sim->solver().model().num_pairs());
   }
-  const double dt = m_scene.animation
-                        ? 1.0 / (m_scene.animation->fps * double(spec.steps_per_frame))
-                        : 0.0;
+  const double dt =
+      m_scene.animation ? 1.0 / (m_scene.animation->fps * double(spec.steps_per_frame)) : 0.0;
   while (rt.state_frame < frame) {
     const int f = rt.state_frame + 1;
     for (int k = 0; k < spec.steps_per_frame; ++k) {
@@ -118,7 +136,12 @@ void Session::add_lcp_items(render::RenderScene& rs, int frame) {
   const LcpSpec& spec = *m_scene.lcp;
   auto particles = lcp_particles(frame);
   const LcpRuntime& rt = *m_lcp;
-  if (spec.render.show_head) {
+  if (!spec.mesh.empty()) {
+    // The asset's mesh item (drawn by render_scene with its material) follows the head pose.
+    const auto head_mesh = mesh(mesh_index(spec.mesh));
+    for (auto& item : rs.meshes)
+      if (item.mesh == head_mesh) item.transform = rt.last_head * item.transform;
+  } else if (spec.render.show_head) {
     render::MeshItem head;
     head.mesh = rt.head;
     head.transform = rt.last_head;

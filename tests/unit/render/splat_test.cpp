@@ -423,3 +423,53 @@ TEST_F(Splat, HairSheetSceneRenders) {
     }
   EXPECT_LT(lon, 0.97 * loff);
 }
+
+TEST_F(Splat, OpaqueHairShowsTheConfiguredColourTimesTheLight) {
+  // A dense slab of vertical hair, fully opaque (uniform white texture), lit from the eye: the
+  // image is the Kajiya-Kay x Goldman colour of the hair (CPU formula) in linear light, without
+  // any tint from the background or the hair texture. With specular on, the highlight adds grey
+  // (the Kajiya-Kay highlight is uncoloured), so a dark colour looks paler. The light comes from
+  // the eye and the exponent is low, so the highlight hardly varies over the visible particles
+  // (their view directions differ by a few degrees).
+  const Vec3 colour(0.2, 0.105, 0.05);
+  auto white = std::make_shared<image::ImageRGBA8>(8, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 4; ++c) white->at(x, y, c) = 255;
+  for (const double ks : {0.0, 0.25}) {
+    RenderScene s;
+    s.camera.eye = Vec3(0, 0, 3);
+    s.camera.fov_y = 0.5;
+    s.background = Vec3(0.6, 0.63, 0.67);
+    s.ambient_color = Vec3(0, 0, 0);
+    DirectionalLight l;
+    l.direction = Vec3(0, 0, -1);
+    l.intensity = 1.5;
+    s.lights.push_back(l);
+    ParticleItem it = hair_item(particle_block(Vec3::Zero(), 0.6, 10), 0.06, 1.0);
+    it.color = colour;
+    it.hair_texture = white;
+    it.splat.self_shadow = false;
+    it.splat.specular = ks;
+    it.splat.shininess = 4;
+    s.particles.push_back(it);
+    const auto img = renderer().render(s, settings(96, 96));
+    maybe_save(img, ks > 0 ? "splat_colour_specular.png" : "splat_colour.png");
+    Vec3 mean = Vec3::Zero();
+    int n = 0;
+    for (int y = 40; y < 56; ++y)
+      for (int x = 40; x < 56; ++x, ++n)
+        for (int c = 0; c < 3; ++c) mean[c] += srgb_to_linear(img.at(x, y, c));
+    mean /= double(n);
+    const Vec3 to_eye = (s.camera.eye - Vec3::Zero()).normalized();
+    const Vec3 expect =
+        l.intensity * kajiya_goldman(Vec3(0, 1, 0), -l.direction, to_eye, colour, it.splat);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(mean[c], expect[c], 0.02 * expect.maxCoeff() + 0.004)
+          << "ks " << ks << " channel " << c;
+    if (ks == 0.0) {  // the hue is the configured one: channel ratios as in `colour`
+      EXPECT_NEAR(mean[1] / mean[0], colour[1] / colour[0], 0.05);
+      EXPECT_NEAR(mean[2] / mean[0], colour[2] / colour[0], 0.05);
+    }
+  }
+}

@@ -35,6 +35,7 @@ std::string read_error(const Json& j) {
 Json small_lcp(const std::string& name, int frames = 4) {
   Json j = scene_json(name);
   j["lcp"]["scenario"]["spacing"] = 0.02;
+  j["lcp"]["scenario"]["settle_time"] = 0.1;
   if (j["lcp"]["scenario"].value("wind", false)) j["lcp"]["scenario"]["air_spacing"] = 0.04;
   j["animation"]["frames"] = frames;
   j["render"]["width"] = 96;
@@ -51,8 +52,7 @@ std::vector<Vec3f> positions_at(const Json& j, int frame, int threads = 2) {
 }  // namespace
 
 TEST(LcpScene, ShippedScenesReadAndRoundTrip) {
-  for (const char* n :
-       {"lcp_back_hair", "lcp_back_hair_nointeraction", "lcp_shake", "lcp_wind"}) {
+  for (const char* n : {"lcp_back_hair", "lcp_back_hair_nointeraction", "lcp_shake", "lcp_wind"}) {
     const Scene s = read_scene(scene_json(n), JsonSource{n});
     ASSERT_TRUE(s.lcp) << n;
     ASSERT_TRUE(s.animation) << n;
@@ -135,8 +135,60 @@ TEST(LcpScene, RenderSceneHasSplatHairAndHead) {
   EXPECT_GT(ps.size(), 50u);
   EXPECT_EQ(ps.directions.size(), ps.size());
   for (const auto& t : ps.directions) EXPECT_NEAR(t.norm(), 1.0f, 1e-3f);
-  EXPECT_EQ(rs.meshes.size(), 1u);  // the head
+  ASSERT_EQ(rs.meshes.size(), 1u);  // the head asset, textured
+  EXPECT_TRUE(rs.meshes[0].material.albedo_map);
   EXPECT_TRUE(rs.particles[0].splat.self_shadow);
+  // The hair grows on the head: every particle lies within the hair length of the mesh's box.
+  Eigen::AlignedBox3d box = rs.meshes[0].mesh->bounds();
+  box.extend(box.min() - Vec3::Constant(s.scene().lcp->scenario.hair_length));
+  box.extend(box.max() + Vec3::Constant(s.scene().lcp->scenario.hair_length));
+  for (const auto& p : ps.positions) EXPECT_TRUE(box.contains(p.cast<double>()));
+}
+
+TEST(LcpScene, MeshHeadTurnsWithTheShake) {
+  Context ctx(2);
+  auto s = Session::from_json(small_lcp("lcp_shake", 12), scenes_dir(), "x", ctx);
+  const auto rs0 = s.render_scene(0);
+  const auto rs = s.render_scene(11);
+  ASSERT_EQ(rs.meshes.size(), 1u);
+  EXPECT_TRUE(rs0.meshes[0].transform.isApprox(Affine3::Identity()));
+  // The head rotates about +y through the pivot: the mesh transform is a rotation about y.
+  const Mat3 r = rs.meshes[0].transform.linear();
+  EXPECT_GT((r - Mat3::Identity()).norm(), 0.05);
+  EXPECT_NEAR((r * Vec3::UnitY() - Vec3::UnitY()).norm(), 0.0, 1e-9);
+}
+
+TEST(LcpScene, UnknownMeshNameFailsWithJsonPath) {
+  Json j = scene_json("lcp_back_hair");
+  j["lcp"]["mesh"] = "haed";
+  const std::string e = read_error(j);
+  EXPECT_THAT(e, HasSubstr("lcp.mesh"));
+  EXPECT_THAT(e, HasSubstr("did you mean \"head\""));
+  j = scene_json("lcp_back_hair");
+  j["lcp"]["scenario"]["mesh_head"]["curve1"][0] = Json::array({0.0, 0.0, 0.0});
+  Context ctx(1);
+  auto s = Session::from_json(j, scenes_dir(), "x", ctx);
+  try {
+    s.lcp_particles(0);
+    ADD_FAILURE() << "an open scalp loop was accepted";
+  } catch (const Error& err) {
+    EXPECT_THAT(std::string(err.what()), HasSubstr("mesh_head.curve0"));
+  }
+}
+
+TEST(LcpScene, SettlingBeforeFrameZeroCalmsTheFirstFrame) {
+  // The largest particle displacement over the first frame is smaller after settling.
+  auto first_move = [&](double settle) {
+    Json j = small_lcp("lcp_back_hair", 2);
+    j["lcp"].erase("part");
+    j["lcp"]["scenario"]["settle_time"] = settle;
+    const auto a = positions_at(j, 0), b = positions_at(j, 1);
+    double m = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, double((a[i] - b[i]).norm()));
+    return m;
+  };
+  const double raw = first_move(0.0), settled = first_move(0.6);
+  EXPECT_LT(settled, 0.5 * raw) << raw << " " << settled;
 }
 
 TEST(LcpScene, StillSceneHasOnlyFrameZero) {
