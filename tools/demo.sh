@@ -27,3 +27,7 @@ echo "demo: wrote out/wrinkles-smile.png"
 echo "demo: wrote out/hand.png"
 "$FOLLICLE" animate data/scenes/hand_flexion_anim.json -o out/hand-frames --mp4 out/hand.mp4
 echo "demo: wrote out/hand.mp4"
+# Bando 2003 loosely connected particle hair blown by SPH wind (Fig. 3.9): the clip and one frame.
+"$FOLLICLE" animate data/scenes/lcp_wind.json -o out/lcp-wind-frames --mp4 out/lcp-wind.mp4
+cp out/lcp-wind-frames/frame_0024.png out/lcp-wind.png
+echo "demo: wrote out/lcp-wind.png and out/lcp-wind.mp4"

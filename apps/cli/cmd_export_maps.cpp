@@ -44,9 +44,10 @@ int run_export_maps(const GlobalOptions& g, const ExportArgs& a) {
   }
   progress.finish();
   if (!g.quiet)
-    fmt::print("wrote height, normal and displacement maps (EXR + PNG) of the rest state and "
-               "frames {}-{} to {}\n",
-               first, last, dir.string());
+    fmt::print(
+        "wrote height, normal and displacement maps (EXR + PNG) of the rest state and "
+        "frames {}-{} to {}\n",
+        first, last, dir.string());
   return 0;
 }
 

@@ -72,7 +72,7 @@ struct ExportArgs {
   std::string hair;  // output strand file (.hair, .tfx, .usda, .obj)
   int frame = 0;
   std::string units = "m";
-  std::string cache;  // strand cache folder, "" = none
+  std::string cache;   // strand cache folder, "" = none
   std::string maps;    // wrinkle-map folder, "" = none (cmd_export_maps.cpp)
   std::string frames;  // "A-B" for --maps, "" = every frame
   std::string mesh;    // deformed face mesh (.obj, .ply, .gltf, .glb), "" = none

@@ -17,7 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path default_head_path() { return find_data("meshes/lee_perry_smith/head.obj"); }
+fs::path default_head_path() {
+  return find_data("meshes/lee_perry_smith/head.obj");
+}
 
 std::size_t size_of(const Sizes& s, const char* key, double lo) {
   const double v = s.at(key);

@@ -11,7 +11,9 @@
 namespace follicle::workloads {
 namespace {
 
-std::filesystem::path find_head_dir() { return find_data("meshes/lee_perry_smith"); }
+std::filesystem::path find_head_dir() {
+  return find_data("meshes/lee_perry_smith");
+}
 
 class RenderHead final : public WorkloadInstance {
  public:

@@ -23,9 +23,9 @@ class WorkloadInstance {
 };
 
 struct Workload {
-  std::string name;         // e.g. "mesh-load"
-  std::string description;  // one line
-  Sizes default_sizes;      // every accepted --size key with its default
+  std::string name;             // e.g. "mesh-load"
+  std::string description;      // one line
+  Sizes default_sizes;          // every accepted --size key with its default
   std::string throughput_unit;  // e.g. "queries/s"
   std::function<std::unique_ptr<WorkloadInstance>(const Context&, const Sizes&)> make;
 };

@@ -9,11 +9,11 @@
 #include "follicle/render/renderer.hpp"
 #include "testing/testing.hpp"
 
-#define FOLLICLE_HEADLESS_RENDERER_OR_SKIP(var, ctx)                        \
-  std::unique_ptr<::follicle::render::Renderer> var;                        \
-  try {                                                                     \
-    var = ::follicle::render::Renderer::create_headless(ctx);               \
-  } catch (const ::follicle::render::ContextUnavailable& e_) {              \
-    if (::follicle::test::gl_required()) FAIL() << e_.what();               \
-    GTEST_SKIP() << "no headless OpenGL 3.3: " << e_.what();                \
+#define FOLLICLE_HEADLESS_RENDERER_OR_SKIP(var, ctx)           \
+  std::unique_ptr<::follicle::render::Renderer> var;           \
+  try {                                                        \
+    var = ::follicle::render::Renderer::create_headless(ctx);  \
+  } catch (const ::follicle::render::ContextUnavailable& e_) { \
+    if (::follicle::test::gl_required()) FAIL() << e_.what();  \
+    GTEST_SKIP() << "no headless OpenGL 3.3: " << e_.what();   \
   }

@@ -18,9 +18,9 @@ std::filesystem::path scratch_dir(const std::string& name);
 }  // namespace follicle::test
 
 /// Skips the current test when the shared data folder (or a file inside it) is missing.
-#define FOLLICLE_REQUIRE_SHARED(relpath)                                                     \
-  do {                                                                                       \
-    auto _d = ::follicle::test::shared_data_dir();                                        \
-    if (_d.empty() || !std::filesystem::exists(_d / (relpath)))                              \
-      GTEST_SKIP() << "shared data not available: " << (relpath);                            \
+#define FOLLICLE_REQUIRE_SHARED(relpath)                          \
+  do {                                                            \
+    auto _d = ::follicle::test::shared_data_dir();                \
+    if (_d.empty() || !std::filesystem::exists(_d / (relpath)))   \
+      GTEST_SKIP() << "shared data not available: " << (relpath); \
   } while (0)

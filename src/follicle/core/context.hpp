@@ -1,10 +1,10 @@
 #pragma once
 // Context: what every long-running function receives instead of globals: a logger, the thread
 // budget (a TBB arena of that size) and the base random seed.
+#include <tbb/task_arena.h>
+
 #include <cstdint>
 #include <memory>
-
-#include <tbb/task_arena.h>
 
 namespace spdlog {
 class logger;

@@ -14,10 +14,15 @@ bool Progress::terminal_attached() {
 }
 
 Progress::Progress(std::string label, std::size_t total, bool enabled)
-    : m_label(std::move(label)), m_total(total), m_enabled(enabled && terminal_attached()),
-      m_start(std::chrono::steady_clock::now()), m_last_draw(m_start) {}
+    : m_label(std::move(label)),
+      m_total(total),
+      m_enabled(enabled && terminal_attached()),
+      m_start(std::chrono::steady_clock::now()),
+      m_last_draw(m_start) {}
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+  finish();
+}
 
 void Progress::tick(std::size_t n) {
   m_done += n;

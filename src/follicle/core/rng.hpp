@@ -14,11 +14,11 @@ class Rng {
   /// Independent stream number `index` derived from `seed` (SplitMix64 mixing).
   static Rng stream(uint64_t seed, uint64_t index);
 
-  uint64_t next_u64();             // xoshiro256**
-  double uniform();                // [0, 1), 53 random bits
+  uint64_t next_u64();  // xoshiro256**
+  double uniform();     // [0, 1), 53 random bits
   double uniform(double lo, double hi);
-  uint32_t below(uint32_t n);      // [0, n), unbiased
-  double normal();                 // standard normal (Box-Muller, no cached second value)
+  uint32_t below(uint32_t n);  // [0, n), unbiased
+  double normal();             // standard normal (Box-Muller, no cached second value)
   double normal(double mean, double sigma) { return mean + sigma * normal(); }
 
  private:

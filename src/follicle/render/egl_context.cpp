@@ -1,5 +1,4 @@
 #include "follicle/render/egl_context.hpp"
-#include "follicle/render/renderer.hpp"
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -8,6 +7,7 @@
 #include <vector>
 
 #include "follicle/core/error.hpp"
+#include "follicle/render/renderer.hpp"
 
 namespace follicle::render {
 namespace {

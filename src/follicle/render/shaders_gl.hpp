@@ -42,8 +42,8 @@ void main() {
 )";
 
 // Features are compile-time (#define SHADING 0|1|2, HAS_ALBEDO, HAS_HEIGHT, HAS_NORMALMAP,
-// HAS_SHADOW, HAS_LIGHTMAP): llvmpipe runs both sides of data-dependent branches, so texture fetches behind
-// a run-time flag would cost as much as taken ones.
+// HAS_SHADOW, HAS_LIGHTMAP): llvmpipe runs both sides of data-dependent branches, so texture
+// fetches behind a run-time flag would cost as much as taken ones.
 inline constexpr const char* kMeshFs = R"(
 in vec3 vPos;
 in vec3 vNormal;

@@ -22,8 +22,9 @@ void LcpSpec::validate() const {
     if (!(part->t1 > part->t0))
       fail("part.t1 ({}) must be greater than part.t0 ({})", part->t1, part->t0);
     if (scenario.shake || scenario.wind)
-      fail("part: the parting force is for the back hair under gravity only; turn off "
-           "scenario.shake and scenario.wind");
+      fail(
+          "part: the parting force is for the back hair under gravity only; turn off "
+          "scenario.shake and scenario.wind");
   }
 }
 

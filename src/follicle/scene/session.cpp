@@ -220,11 +220,11 @@ std::string Session::summary() const {
                        m_scene.hand->flexion ? fmt::format("{}", *m_scene.hand->flexion)
                                              : std::string("from the flexion track"));
   if (m_scene.lcp)
-    out += fmt::format("lcp hair: spacing {} m, hair-hair {}{}{}{}\n", m_scene.lcp->scenario.spacing,
-                       m_scene.lcp->dynamics.hair_hair ? "on" : "off",
-                       m_scene.lcp->scenario.shake ? ", head shake" : "",
-                       m_scene.lcp->scenario.wind ? ", SPH wind" : "",
-                       m_scene.lcp->part ? ", parting force" : "");
+    out += fmt::format(
+        "lcp hair: spacing {} m, hair-hair {}{}{}{}\n", m_scene.lcp->scenario.spacing,
+        m_scene.lcp->dynamics.hair_hair ? "on" : "off",
+        m_scene.lcp->scenario.shake ? ", head shake" : "",
+        m_scene.lcp->scenario.wind ? ", SPH wind" : "", m_scene.lcp->part ? ", parting force" : "");
   if (m_scene.animation)
     out += fmt::format("animation: {} frames at {} fps\n", m_scene.animation->frame_count(),
                        m_scene.animation->fps);

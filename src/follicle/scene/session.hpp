@@ -14,8 +14,8 @@
 #include "follicle/image/image.hpp"
 #include "follicle/render/render_scene.hpp"
 #include "follicle/scene/scene.hpp"
-#include "follicle/skin/hand_rig.hpp"
 #include "follicle/skin/face_rig.hpp"
+#include "follicle/skin/hand_rig.hpp"
 
 namespace follicle::scene {
 

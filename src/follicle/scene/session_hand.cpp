@@ -35,9 +35,9 @@ HandRuntime& hand_rt(std::shared_ptr<HandRuntime>& p, const Scene& s, const std:
       lo = lo.cwiseMin(x.cast<double>());
       hi = hi.cwiseMax(x.cast<double>());
     }
-    ctx.log().info("hand: {} vertices, {} faces, bounds ({:.4f} {:.4f} {:.4f})-({:.4f} {:.4f} {:.4f}) m",
-                   m.positions.size(), m.faces.size(), lo.x(), lo.y(), lo.z(), hi.x(), hi.y(),
-                   hi.z());
+    ctx.log().info(
+        "hand: {} vertices, {} faces, bounds ({:.4f} {:.4f} {:.4f})-({:.4f} {:.4f} {:.4f}) m",
+        m.positions.size(), m.faces.size(), lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z());
   }
   return *p;
 }
@@ -55,8 +55,8 @@ double Session::hand_flexion(int frame) const {
 
 skin::HandFrame Session::hand_frame(int frame) {
   if (frame < 0) fail("frame {} is negative", frame);
-  auto& rt = hand_rt(m_hand, m_scene, m_source, resolve(m_scene.hand ? m_scene.hand->makehuman : ""),
-                     *m_ctx);
+  auto& rt = hand_rt(m_hand, m_scene, m_source,
+                     resolve(m_scene.hand ? m_scene.hand->makehuman : ""), *m_ctx);
   if (rt.last && rt.last_frame == frame) return *rt.last;
   rt.last = rt.rig->frame_at_flexion(*m_ctx, hand_flexion(frame), m_scene.hand->wrinkles);
   rt.last_frame = frame;

@@ -143,7 +143,8 @@ void Session::load_skin_setups() {
 }
 
 const skin::FaceRig& Session::face_rig(std::size_t ri) {
-  if (ri >= m_scene.skin.size()) fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
+  if (ri >= m_scene.skin.size())
+    fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
   resolve_skin(ri);
   auto& r = skin_runtime().rigs[ri];
   if (r.rig) return *r.rig;
@@ -189,7 +190,8 @@ const skin::FaceRig& Session::face_rig(std::size_t ri) {
 }
 
 skin::MusclePose Session::skin_pose(std::size_t ri, int frame) {
-  if (ri >= m_scene.skin.size()) fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
+  if (ri >= m_scene.skin.size())
+    fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
   if (frame < 0) fail("frame {} is negative", frame);
   resolve_skin(ri);
   const auto& r = skin_runtime().rigs[ri];

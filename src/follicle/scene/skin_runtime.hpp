@@ -17,7 +17,7 @@ class SkinRuntime {
  public:
   struct Rig {
     bool resolved = false;
-    skin::FaceSetup setup;      // the face-setup file with the scene's wrinkle edits applied
+    skin::FaceSetup setup;         // the face-setup file with the scene's wrinkle edits applied
     skin::MusclePose static_pose;  // expression * weight with the explicit contractions
     std::vector<anim::ScalarTrack> muscle_tracks;  // one per muscle (empty: no track)
     anim::ScalarTrack jaw_track;

@@ -46,8 +46,9 @@ void validate_skin_section(const std::vector<SkinSpec>& skin,
     try {
       (void)anim::parse_interp(s.interp);
     } catch (const Error&) {
-      json_fail(src, p + ".interp",
-                "unknown value \"" + s.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
+      json_fail(
+          src, p + ".interp",
+          "unknown value \"" + s.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
     }
     std::set<std::string> over;
     for (std::size_t k = 0; k < s.wrinkle_overrides.size(); ++k)

@@ -62,8 +62,9 @@ struct WrinkleOverride {
     v("name", name, ParamInfo{"name of a wrinkle of the face-setup file"});
     v("depth", depth, ParamInfo{"furrow depth d", "m", 0.0, 0.1});
     v("width", width, ParamInfo{"furrow width w", "m", 1e-6, 0.1});
-    v("r", r, ParamInfo{"rest amplitude ratio r of (2.4) (r > 0: visible at rest, aged skin)", "",
-                        0.0, 1.0});
+    v("r", r,
+      ParamInfo{"rest amplitude ratio r of (2.4) (r > 0: visible at rest, aged skin)", "", 0.0,
+                1.0});
     v("end_taper", end_taper, ParamInfo{"end taper fraction", "", 0.0, 0.5});
     v("p0", p0, ParamInfo{"Bezier control point 0 (texture space)", "", -10.0, 10.0});
     v("p1", p1, ParamInfo{"Bezier control point 1 (texture space)", "", -10.0, 10.0});
@@ -89,8 +90,8 @@ struct SkinKey {
     v("weight", weight, ParamInfo{"expression weight (0 neutral, 1 full)", "", -2.0, 2.0});
     v("contractions", contractions,
       ParamInfo{"per-muscle contractions by name, replacing the expression's", "", -10.0, 10.0});
-    v("jaw_angle", jaw_angle, ParamInfo{"jaw opening, replacing the expression's", "rad", -1.5,
-                                        1.5});
+    v("jaw_angle", jaw_angle,
+      ParamInfo{"jaw opening, replacing the expression's", "rad", -1.5, 1.5});
   }
 };
 

@@ -84,7 +84,7 @@ TEST(LcpMeshHead, ScalpCoversTheBackAndTopOfTheHead) {
   EXPECT_GT(s.area(), 0.02);  // about a third of a head of radius 0.09 m
   EXPECT_LT(s.area(), 0.06);
   for (const Vec3& p : s.mesh().positions) {
-    EXPECT_LT(p.z(), 0.05);  // behind the forehead hairline
+    EXPECT_LT(p.z(), 0.05);   // behind the forehead hairline
     EXPECT_GT(p.y(), -0.01);  // above the nape
   }
   EXPECT_GT(sc.body().num_planes(), 100u);

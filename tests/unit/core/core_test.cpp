@@ -75,7 +75,8 @@ TEST(Rng, StreamsAreIndependentOfOrder) {
 TEST(Parallel, ForVisitsEveryIndexOnce) {
   Context ctx(2);
   std::vector<std::atomic<int>> hits(10000);
-  parallel_for(ctx, 0, hits.size(), [&](std::size_t i) { hits[i]++; }, 16);
+  parallel_for(
+      ctx, 0, hits.size(), [&](std::size_t i) { hits[i]++; }, 16);
   for (auto& h : hits) EXPECT_EQ(h.load(), 1);
 }
 

@@ -101,7 +101,8 @@ TEST(HandScene, FlexionFollowsTrackAndWrinklesRespond) {
   for (std::size_t i = 0; i < rest.mesh->positions.size(); ++i)
     moved = std::max(moved, (rest.mesh->positions[i] - flexed.mesh->positions[i]).norm());
   for (std::size_t i = 0; i < rest.height_m->storage().size(); ++i)
-    dh = std::max(dh, double(std::abs(rest.height_m->storage()[i] - flexed.height_m->storage()[i])));
+    dh =
+        std::max(dh, double(std::abs(rest.height_m->storage()[i] - flexed.height_m->storage()[i])));
   EXPECT_GT(moved, 0.01);  // fingertips move centimetres
   EXPECT_GT(dh, 1e-6);     // micrometres of relief change
   // The render scene holds the bump-mapped hand.
