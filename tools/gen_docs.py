@@ -5,7 +5,7 @@ describes). With --check, fails when the generated files are out of date."""
 import sys
 from pathlib import Path
 
-ORDER = ["geom", "render", "splat", "anjyo", "hair_render", "skin", "fine", "lcp"]
+ORDER = ["summary", "geom", "render", "splat", "anjyo", "hair_render", "skin", "fine", "lcp"]
 
 HEADERS = {
     "equations": (
