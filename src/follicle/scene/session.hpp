@@ -114,6 +114,9 @@ class Session {
   /// The deformed, wrinkled mesh of skin[rig] at `frame` (mesh-file coordinates in metres, the
   /// asset transform NOT applied; normals of the deformed surface). Cached per frame.
   std::shared_ptr<const geom::TriMesh> skin_mesh(std::size_t rig, int frame);
+  /// The fine-wrinkle relief of skin[rig] at `frame` over the mesh UVs [m] (the bump map of its
+  /// material; Bando 2002 §2.6), or null without "fine". Fields built on first use; cached.
+  std::shared_ptr<const image::ImageF> skin_fine_relief(std::size_t rig, int frame);
   /// Index into scene().skin of the rig on mesh asset `asset`, if any.
   std::optional<std::size_t> skin_rig_of_mesh(std::size_t asset) const;
   /// Loads every face-setup file and checks the skin section against it (for validate).

@@ -4,6 +4,7 @@
 // expression or its contraction track sampled at the frame time. Rigs build on first use.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "follicle/core/error.hpp"
@@ -52,6 +53,43 @@ skin::MusclePose resolve_pose(const skin::MuscleSet& set, const std::string& exp
   }
   if (jaw) pose.jaw_angle = *jaw;
   return pose;
+}
+
+// Direction keys of one fine-wrinkle field on the uv vertices of `base`; a "uv" key goes to the
+// nearest uv vertex used by a face. Errors name the JSON path.
+std::vector<skin::DirectionKey> fine_keys(const geom::TriMesh& base,
+                                          const std::vector<FineDirectionKeySpec>& keys,
+                                          const JsonSource& src, const std::string& path) {
+  std::vector<char> used(base.uvs.size(), 0);
+  for (const auto& f : base.uv_faces)
+    for (int c = 0; c < 3; ++c)
+      if (f[c] >= 0 && std::size_t(f[c]) < used.size()) used[std::size_t(f[c])] = 1;
+  std::vector<skin::DirectionKey> out;
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const auto& key = keys[k];
+    const std::string at = index_path(path, k);
+    int v = -1;
+    if (key.vertex) {
+      v = *key.vertex;
+      if (v < 0 || std::size_t(v) >= base.uvs.size())
+        json_fail(src, at + ".vertex",
+                  fmt::format("uv vertex {} out of range: the mesh has {} uv vertices", v,
+                              base.uvs.size()));
+    } else if (key.uv) {
+      double best = 1e300;
+      for (std::size_t t = 0; t < base.uvs.size(); ++t) {
+        if (!used[t]) continue;
+        const double d = (base.uvs[t] - *key.uv).squaredNorm();
+        if (d < best) {
+          best = d;
+          v = int(t);
+        }
+      }
+      if (v < 0) json_fail(src, at + ".uv", "the mesh has no texture coordinates");
+    }
+    out.push_back({v, key.direction});
+  }
+  return out;
 }
 
 }  // namespace
@@ -239,6 +277,62 @@ void Session::apply_skin(std::size_t asset, render::MeshItem& item, int frame) {
     mat.albedo_map.reset();
     item.vertex_colors = skin_runtime().rigs[*ri].colors;
   }
+  if (s.fine) {
+    mat.height_map = skin_fine_relief(*ri, frame);
+    mat.bump_strength = s.fine->bump_strength;
+  }
+}
+
+std::shared_ptr<const image::ImageF> Session::skin_fine_relief(std::size_t ri, int frame) {
+  if (ri >= m_scene.skin.size())
+    fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
+  const SkinSpec& s = m_scene.skin[ri];
+  if (!s.fine) return nullptr;
+  const FineWrinkleSpec& f = *s.fine;
+  (void)skin_mesh(ri, frame);  // the state of this frame (cached)
+  auto& r = skin_runtime().rigs[ri];
+  if (!r.fine) {
+    // §2.6.1-2.6.2 once per rig, on the base mesh (the mesh asset the FaceRig refines).
+    const JsonSource src{m_source};
+    const std::string p = index_path("skin", ri) + ".fine";
+    const auto base = mesh(mesh_index(s.mesh));
+    // The refinement appends vertices: the base vertices come first, unchanged.
+    const auto& rest = face_rig(ri).rest_mesh().positions;
+    if (rest.size() < base->positions.size() ||
+        !std::equal(base->positions.begin(), base->positions.end(), rest.begin()))
+      fail("{}: {}: the face rig's mesh does not start with the {} base vertices", m_source, p,
+           base->positions.size());
+    const std::array<std::vector<skin::DirectionKey>, 2> keys{
+        fine_keys(*base, f.field0, src, p + ".field0"),
+        fine_keys(*base, f.field1, src, p + ".field1")};
+    const Context gctx(m_ctx->threads(), f.seed, m_ctx->logger_ptr());
+    try {
+      const skin::FineWrinkles w = skin::generate_fine_wrinkles(gctx, *base, keys, f.params);
+      r.fine = std::make_unique<skin::FineWrinkleAnimator>(*base, w);
+      r.fine_depth_m = w.depth_m;
+      m_ctx->log().info("{}: fine wrinkles {}x{} texels, {} + {} furrows", p, w.texels.size,
+                        w.texels.size, w.fields[0].furrows.size(), w.fields[1].furrows.size());
+    } catch (const Error& e) {
+      fail("{}: {}: {}", m_source, p, e.what());
+    }
+  }
+  // The weak pointer keeps the mesh's allocation reserved: an expired one never compares equal.
+  if (r.fine_height && (r.fine_for.lock() == r.last || !f.modulate)) return r.fine_height;
+  auto h = std::make_shared<image::ImageF>();
+  if (f.modulate) {
+    // (2.3) shrinkage perpendicular to each field, measured on the animated surface (muscles,
+    // jaw, tissue; no large wrinkles) at the base vertices, which are the first vertices of the
+    // refined mesh; then (2.4) M(s) modulation of both height fields.
+    r.fine->shrinkage(*m_ctx, r.state.animated, r.fine_s);
+    r.fine->modulate(*m_ctx, r.fine_s, *h);
+  } else {
+    r.fine->rest_relief(*m_ctx, *h);
+  }
+  const float depth = float(r.fine_depth_m);
+  for (float& x : h->storage()) x *= depth;  // relief units -> metres
+  r.fine_height = std::move(h);
+  r.fine_for = r.last;
+  return r.fine_height;
 }
 
 }  // namespace follicle::scene

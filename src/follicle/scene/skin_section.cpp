@@ -63,6 +63,27 @@ void validate_skin_section(const std::vector<SkinSpec>& skin,
         json_fail(src, index_path(p + ".track", k) + ".t",
                   fmt::format("key times must increase strictly ({} after {})", s.track[k].t,
                               s.track[k - 1].t));
+    if (s.fine) {
+      const std::string fp = p + ".fine";
+      for (int f = 0; f < 2; ++f) {
+        const auto& keys = f == 0 ? s.fine->field0 : s.fine->field1;
+        const std::string kp = fp + (f == 0 ? ".field0" : ".field1");
+        if (keys.empty())
+          json_fail(src, kp, "a fine-wrinkle field needs at least one direction key");
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+          const auto& key = keys[k];
+          const std::string at = index_path(kp, k);
+          if (key.vertex.has_value() == key.uv.has_value())
+            json_fail(src, at,
+                      "give exactly one of \"vertex\" (uv vertex index) or \"uv\" (texture "
+                      "position)");
+          const double m = key.direction.norm();
+          if (!(m <= 1.0 + 1e-9))
+            json_fail(src, at + ".direction",
+                      fmt::format("direction magnitude {} is out of range: expected [0, 1]", m));
+        }
+      }
+    }
   }
 }
 

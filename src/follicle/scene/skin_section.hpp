@@ -16,6 +16,7 @@
 #include "follicle/core/types.hpp"
 #include "follicle/scene/json_params.hpp"
 #include "follicle/skin/adaptive_refine_volino1999.hpp"
+#include "follicle/skin/fine_wrinkles_bando2002.hpp"
 #include "follicle/skin/large_wrinkles_bando2002.hpp"
 #include "follicle/skin/skin_color_bando2002.hpp"
 #include "follicle/skin/tissue_bando2002.hpp"
@@ -95,6 +96,52 @@ struct SkinKey {
   }
 };
 
+/// One user-given direction of a fine-wrinkle field (skin::DirectionKey, Bando 2002 §2.6.1): at a
+/// uv vertex of the mesh asset, given by its index or as the uv vertex nearest a texture position.
+struct FineDirectionKeySpec {
+  static constexpr const char* kRequired[] = {"direction"};
+  std::optional<int> vertex;
+  std::optional<Vec2> uv;
+  Vec2 direction = Vec2::Zero();
+
+  template <class V>
+  void visit(V&& v) {
+    v("vertex", vertex,
+      ParamInfo{"uv vertex index of the mesh asset (give vertex or uv)", "", 0.0, 1e9});
+    v("uv", uv,
+      ParamInfo{"texture position; the key goes to the nearest uv vertex (give vertex or uv)", "",
+                -10.0, 10.0});
+    v("direction", direction,
+      ParamInfo{"furrow direction in texture space (u, v); its magnitude m in [0, 1] sets depth, "
+                "width and length of the furrows (2.5)",
+                "", -1.0, 1.0});
+  }
+};
+
+/// Fine-scale wrinkles on the face (Bando 2002 §2.6): two direction fields interpolated from keys
+/// over the mesh asset (the rig's base mesh), furrows carved into two height images, modulated
+/// per frame by M(s) (2.4) of the shrinkage (2.3) perpendicular to each field and bump-mapped.
+struct FineWrinkleSpec {
+  std::vector<FineDirectionKeySpec> field0, field1;
+  skin::FineWrinkleParams params{1024, 1.0, 0.3, 200, true, 60e-6, 0.5};
+  uint64_t seed = 1;
+  double bump_strength = 1.0;
+  bool modulate = true;
+
+  template <class V>
+  void visit(V&& v) {
+    v("field0", field0, ParamInfo{"direction keys of the first field (at least one)"});
+    v("field1", field1, ParamInfo{"direction keys of the second field (at least one)"});
+    params.visit(v);  // resolution, unit_texels, unit_mm, max_failures, fill_pass, depth_m, r
+    v("seed", seed, ParamInfo{"random seed of the furrow carving"});
+    v("bump_strength", bump_strength,
+      ParamInfo{"bump-map strength of the fine relief on the render material", "", 0.0, 100.0});
+    v("modulate", modulate,
+      ParamInfo{"modulate the relief per frame by M(s) (2.4) of the shrinkage (false: the rest "
+                "relief, M = r)"});
+  }
+};
+
 /// A face rig on one mesh asset.
 struct SkinSpec {
   static constexpr const char* kRequired[] = {"mesh", "muscles"};
@@ -115,6 +162,7 @@ struct SkinSpec {
   SkinShading shading = SkinShading::Lafortune;
   std::vector<SkinKey> track;
   std::string interp = "smooth";
+  std::optional<FineWrinkleSpec> fine;
 
   template <class V>
   void visit(V&& v) {
@@ -148,6 +196,8 @@ struct SkinSpec {
     v("track", track,
       ParamInfo{"contraction keyframes over the animation clock (needs \"animation\")"});
     v("interp", interp, ParamInfo{"track interpolation: step, linear, smooth"});
+    v("fine", fine,
+      ParamInfo{"fine-scale wrinkles (Bando 2002 §2.6): two direction fields, bump-mapped relief"});
   }
 };
 

@@ -95,7 +95,7 @@ const char* kSkinScenes[] = {"skin_thinking", "skin_thinking_nowrinkles",
                              "skin_troubled", "skin_troubled_nowrinkles",
                              "skin_angry",    "skin_angry_nowrinkles",
                              "skin_aged",     "skin_track",
-                             "default"};
+                             "default",       "skin_fine_forehead"};
 
 }  // namespace
 
