@@ -12,17 +12,15 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/scene/session.hpp"
+#include "scene_test_util.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
 using namespace follicle::scene;
+using namespace follicle::scene::testutil;
 using ::testing::HasSubstr;
 
 namespace {
-
-std::filesystem::path scenes_dir() {
-  return test::source_dir() / "data" / "scenes";
-}
 
 // The forehead scene with a quicker rig and smaller height images.
 Json forehead() {
@@ -36,15 +34,6 @@ Json forehead() {
 const render::MeshItem& skin_item(const render::RenderScene& rs) {
   if (rs.meshes.size() != 1) fail("expected one mesh item, got {}", rs.meshes.size());
   return rs.meshes[0];
-}
-
-std::string read_error(const Json& j) {
-  try {
-    read_scene(j, JsonSource{"x.json"});
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
 }
 
 std::string relief_error(const Json& j) {

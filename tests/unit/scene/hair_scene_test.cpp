@@ -5,30 +5,15 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/scene/session.hpp"
+#include "scene_test_util.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
 using namespace follicle::scene;
+using namespace follicle::scene::testutil;
 using ::testing::HasSubstr;
 
 namespace {
-
-std::filesystem::path scenes_dir() {
-  return test::source_dir() / "data" / "scenes";
-}
-
-Json scene_json(const std::string& name) {
-  return parse_json_file(scenes_dir() / (name + ".json"));
-}
-
-std::string read_error(const Json& j) {
-  try {
-    read_scene(j, JsonSource{"x.json"});
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // A small, quick version of a shipped scene (few strands, short clip).
 Session small_session(const std::string& name, const Context& ctx, double density = 0.05,

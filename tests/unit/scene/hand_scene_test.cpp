@@ -7,30 +7,15 @@
 #include "follicle/core/error.hpp"
 #include "follicle/image/image_io.hpp"
 #include "follicle/scene/session.hpp"
+#include "scene_test_util.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
 using namespace follicle::scene;
+using namespace follicle::scene::testutil;
 using ::testing::HasSubstr;
 
 namespace {
-
-std::filesystem::path scenes_dir() {
-  return test::source_dir() / "data" / "scenes";
-}
-
-Json scene_json(const std::string& name) {
-  return parse_json_file(scenes_dir() / (name + ".json"));
-}
-
-std::string read_error(const Json& j) {
-  try {
-    read_scene(j, JsonSource{"x.json"});
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // A quick version of a shipped hand scene: small fine-wrinkle maps, little refinement.
 Json small_hand(const std::string& name, int frames = 0) {

@@ -13,30 +13,15 @@
 #include "follicle/core/error.hpp"
 #include "follicle/scene/session.hpp"
 #include "follicle/skin/skin_json.hpp"
+#include "scene_test_util.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
 using namespace follicle::scene;
+using namespace follicle::scene::testutil;
 using ::testing::HasSubstr;
 
 namespace {
-
-std::filesystem::path scenes_dir() {
-  return test::source_dir() / "data" / "scenes";
-}
-
-Json scene_json(const std::string& name) {
-  return parse_json_file(scenes_dir() / (name + ".json"));
-}
-
-std::string read_error(const Json& j) {
-  try {
-    read_scene(j, JsonSource{"x.json"});
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // Errors that need the face-setup file (expression, wrinkle and muscle names): resolving the pose.
 std::string pose_error(const Json& j) {
