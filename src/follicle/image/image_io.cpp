@@ -10,6 +10,7 @@
 #include <stb_image.h>
 #include <stb_image_write.h>
 
+#include <cctype>
 #include <exception>
 #include <memory>
 #include <string>
@@ -158,6 +159,17 @@ void write_exr(const std::filesystem::path& path, const ImageRGBF& img) {
 void write_exr(const std::filesystem::path& path, const ImageRGBAF& img) {
   static constexpr const char* kNames[] = {"R", "G", "B", "A"};
   write_exr_impl(path, img, kNames);
+}
+
+ImageF read_gray_map(const std::filesystem::path& path) {
+  auto ext = path.extension().string();
+  for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr") return read_exr_gray(path);
+  const ImageGray8 g = read_png_gray(path);
+  ImageF out(g.width(), g.height());
+  for (int y = 0; y < g.height(); ++y)
+    for (int x = 0; x < g.width(); ++x) out.at(x, y) = float(g.at(x, y)) / 255.0f;
+  return out;
 }
 
 }  // namespace follicle::image

@@ -48,10 +48,7 @@ std::shared_ptr<const geom::ParticleSet> Session::lcp_particles(int frame) {
       const auto file = resolve(spec.length_map);
       if (!std::filesystem::is_regular_file(file))
         fail_at(m_source, "lcp.length_map: image not found: {}", file.string());
-      const image::ImageGray8 g = image::read_png_gray(file);
-      length_map = image::ImageF(g.width(), g.height());
-      for (int y = 0; y < g.height(); ++y)
-        for (int x = 0; x < g.width(); ++x) length_map.at(x, y) = float(g.at(x, y)) / 255.0f;
+      length_map = image::read_gray_map(file);
     }
     try {
       rt.sim = std::make_unique<hair::LcpScenario>(ctx, spec.scenario, spec.dynamics,

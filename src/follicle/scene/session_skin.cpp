@@ -197,18 +197,7 @@ const skin::FaceRig& Session::face_rig(std::size_t ri) {
   fp.wrinkles_enabled = s.wrinkles;
   std::optional<image::ImageF> thickness;
   if (!s.tissue.thickness_map.empty()) {
-    const auto f = resolve(s.tissue.thickness_map);
-    auto ext = f.extension().string();
-    for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".exr") {
-      thickness = image::read_exr_gray(f);
-    } else {
-      const auto g = image::read_png_gray(f);
-      image::ImageF t(g.width(), g.height());
-      for (int y = 0; y < g.height(); ++y)
-        for (int x = 0; x < g.width(); ++x) t.at(x, y) = float(g.at(x, y)) / 255.0f;
-      thickness = std::move(t);
-    }
+    thickness = image::read_gray_map(resolve(s.tissue.thickness_map));
   }
   try {
     r.rig = std::make_unique<skin::FaceRig>(*base, r.setup.muscles, r.setup.wrinkles, fp,
