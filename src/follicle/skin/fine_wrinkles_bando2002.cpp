@@ -51,6 +51,20 @@ Vec2 dir_to_texel(const Vec2& d) {
   return Vec2(d.x(), -d.y());
 }
 
+/// floor and ceil to int for the texel loops: std::floor compiles to a library call on the
+/// baseline x86-64 target (no SSE4.1 roundsd) and was a visible part of the furrow walk. Exact
+/// for |x| < 1e9; larger values are clamped first (texel indices are far smaller).
+inline int ifloor(double x) {
+  x = x > -1e9 ? std::min(x, 1e9) : -1e9;  // NaN -> -1e9
+  const int i = int(x);
+  return i - int(x < double(i));
+}
+inline int iceil(double x) {
+  x = x > -1e9 ? std::min(x, 1e9) : -1e9;  // NaN -> -1e9
+  const int i = int(x);
+  return i + int(x > double(i));
+}
+
 /// Barycentric coordinates (b1, b2) of p in triangle (a, b, c); returns false when degenerate.
 bool barycentric(const Vec2& p, const Vec2& a, const Vec2& b, const Vec2& c, double& b1,
                  double& b2) {
@@ -68,8 +82,12 @@ double segment_hit(const Vec2& p, const Vec2& q, const Vec2& a, const Vec2& b) {
   const double den = r.x() * s.y() - r.y() * s.x();
   if (std::abs(den) < 1e-18) return -1;  // parallel: treated as no crossing
   const Vec2 ap = a - p;
-  const double t = (ap.x() * s.y() - ap.y() * s.x()) / den;
-  const double u = (ap.x() * r.y() - ap.y() * r.x()) / den;
+  const double tn = ap.x() * s.y() - ap.y() * s.x(), un = ap.x() * r.y() - ap.y() * r.x();
+  // Early out without dividing, only where the test below surely fails (most grid candidates).
+  const double sg = den > 0 ? 1.0 : -1.0, ad = std::abs(den) * (1.0 + 1e-12);
+  if (sg * tn <= 0.0 || sg * un < 0.0 || sg * tn > ad || sg * un > ad) return -1;
+  const double t = tn / den;
+  const double u = un / den;
   if (t <= 1e-9 || t > 1.0 || u < 0.0 || u > 1.0) return -1;
   return t;
 }
@@ -148,10 +166,10 @@ class SegmentGrid {
   };
   template <class F>
   void visit_cells(const Vec2& a, const Vec2& b, F&& f) {
-    const int x0 = clampi(int(std::floor(std::min(a.x(), b.x()) / m_cell)));
-    const int x1 = clampi(int(std::floor(std::max(a.x(), b.x()) / m_cell)));
-    const int y0 = clampi(int(std::floor(std::min(a.y(), b.y()) / m_cell)));
-    const int y1 = clampi(int(std::floor(std::max(a.y(), b.y()) / m_cell)));
+    const int x0 = clampi(ifloor(std::min(a.x(), b.x()) / m_cell));
+    const int x1 = clampi(ifloor(std::max(a.x(), b.x()) / m_cell));
+    const int y0 = clampi(ifloor(std::min(a.y(), b.y()) / m_cell));
+    const int y1 = clampi(ifloor(std::max(a.y(), b.y()) / m_cell));
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) f(m_cells[std::size_t(y) * m_n + x]);
   }
@@ -161,46 +179,104 @@ class SegmentGrid {
   std::vector<std::vector<Seg>> m_cells;
 };
 
+/// Rows of the capsule of radius R around segment ab (the points within R of it), for the
+/// stroke rasterizers below. Hand-written: the furrow walk draws two strokes per step and
+/// scanning each stroke's bounding box was the hot spot of §2.6.2.
+class CapsuleRows {
+ public:
+  CapsuleRows(const Vec2& a, const Vec2& b, double R) : m_a(a), m_b(b), m_R2(R * R) {
+    const Vec2 ab = b - a;
+    const double len = ab.norm();
+    if (len > 0) {
+      const Vec2 u = ab / len;
+      // The band: 0 <= u.(p - a) <= len and |n.(p - a)| <= R with n = (-u.y, u.x); on a row
+      // both are linear in x (constants per segment here, one multiply-add per row below).
+      m_along = {u.x(), u.y(), 0.0, len, u.x() != 0.0 ? 1.0 / u.x() : 0.0};
+      m_across = {-u.y(), u.x(), -R, R, u.y() != 0.0 ? -1.0 / u.y() : 0.0};
+      m_band = true;
+    }
+  }
+  /// Texels x0..x1 of the row whose centre line is y = yc that can hold a centre within R of
+  /// the segment (one texel of margin for rounding), clipped to [0, w-1]; false when none.
+  bool span(double yc, int w, int& x0, int& x1) const {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    auto disc = [&](const Vec2& c) {
+      const double dy = yc - c.y(), q = m_R2 - dy * dy;
+      if (q >= 0) {
+        const double hw = std::sqrt(q);
+        lo = std::min(lo, c.x() - hw);
+        hi = std::max(hi, c.x() + hw);
+      }
+    };
+    disc(m_a);
+    disc(m_b);
+    if (m_band) {
+      const double dy = yc - m_a.y();
+      double l = -std::numeric_limits<double>::infinity(), h = -l;
+      for (const Linear* c : {&m_along, &m_across}) {
+        // vmin <= slope (x - a.x) + off <= vmax, off = dy_coef * dy
+        const double off = c->dy_coef * dy;
+        if (c->slope == 0.0) {
+          if (off < c->vmin || off > c->vmax) return lo <= hi && finish(lo, hi, w, x0, x1);
+          continue;
+        }
+        double e0 = (c->vmin - off) * c->inv_slope, e1 = (c->vmax - off) * c->inv_slope;
+        if (e0 > e1) std::swap(e0, e1);
+        l = std::max(l, e0);
+        h = std::min(h, e1);
+      }
+      if (l <= h) {
+        lo = std::min(lo, m_a.x() + l);
+        hi = std::max(hi, m_a.x() + h);
+      }
+    }
+    return lo <= hi && finish(lo, hi, w, x0, x1);
+  }
+
+ private:
+  struct Linear {
+    double slope, dy_coef, vmin, vmax, inv_slope;
+  };
+  static bool finish(double lo, double hi, int w, int& x0, int& x1) {
+    // Texel x has its centre at x + 0.5.
+    x0 = std::max(0, ifloor(lo - 0.5) - 1);
+    x1 = std::min(w - 1, iceil(hi - 0.5) + 1);
+    return x0 <= x1;
+  }
+  Vec2 m_a, m_b;
+  double m_R2;
+  bool m_band = false;
+  Linear m_along{}, m_across{};
+};
+
 /// The texels of image::draw_line(img, a, b, width, ...) with their coverage: calls
 /// f(texel index, cov) for every texel with cov > 0, with the same distance and coverage
 /// arithmetic as image/raster.cpp, so blending gives the same values texel for texel. Visits in
-/// each row only the texels that can be covered instead of draw_line's whole bounding box, and
-/// does not allocate. Hand-written: carving draws two segments per furrow step, which made
-/// draw_line the hot spot of §2.6.2. Returns false (nothing visited) for non-finite input.
+/// each row only the texels of the stroke's capsule instead of draw_line's whole bounding box,
+/// and does not allocate. Returns false (nothing visited) for non-finite input.
+/// Only rows ylo .. yhi - 1 are visited (a band of the image; default all).
 template <class F>
 bool visit_segment(int w, int h, const Vec2& a, const Vec2& b, double width, const float* img,
-                   F&& f) {
+                   F&& f, int ylo = 0, int yhi = std::numeric_limits<int>::max()) {
   const double r = 0.5 * width;
   if (!a.allFinite() || !b.allFinite() || !std::isfinite(r) || r < 0) return false;
   // draw_polyline's box (r + 1 around the segment).
-  const int bx0 = std::max(0, int(std::floor(std::min(a.x(), b.x()) - r - 1)));
-  const int by0 = std::max(0, int(std::floor(std::min(a.y(), b.y()) - r - 1)));
-  const int bx1 = std::min(w - 1, int(std::ceil(std::max(a.x(), b.x()) + r + 1)));
-  const int by1 = std::min(h - 1, int(std::ceil(std::max(a.y(), b.y()) + r + 1)));
+  const int bx0 = std::max(0, ifloor(std::min(a.x(), b.x()) - r - 1));
+  const int by0 = std::max(ylo, ifloor(std::min(a.y(), b.y()) - r - 1));
+  const int bx1 = std::min(w - 1, iceil(std::max(a.x(), b.x()) + r + 1));
+  const int by1 = std::min({h - 1, yhi - 1, iceil(std::max(a.y(), b.y()) + r + 1)});
   if (bx0 > bx1 || by0 > by1) return true;
   const Vec2 ab = b - a;
   const double l2 = ab.squaredNorm();
-  // Coverage needs d < r + 0.5; rows and columns are bounded with one more texel of margin.
-  const double R = r + 1.5;
-  const double out2 = (r + 0.5 + 1e-6) * (r + 0.5 + 1e-6);
+  // Coverage needs d < r + 0.5.
+  const double out = r + 0.5 + 1e-6, out2 = out * out;
+  const CapsuleRows cap(a, b, out);
   for (int y = by0; y <= by1; ++y) {
     const double yc = y + 0.5;
-    // x extent of the part of the segment within R of the row's centre line.
-    double lo, hi;
-    if (ab.y() == 0.0) {
-      if (std::abs(a.y() - yc) > R) continue;
-      lo = std::min(a.x(), b.x());
-      hi = std::max(a.x(), b.x());
-    } else {
-      const double ta = (yc - R - a.y()) / ab.y(), tb = (yc + R - a.y()) / ab.y();
-      const double t0 = std::max(0.0, std::min(ta, tb)), t1 = std::min(1.0, std::max(ta, tb));
-      if (t0 > t1) continue;
-      const double xa = a.x() + t0 * ab.x(), xb = a.x() + t1 * ab.x();
-      lo = std::min(xa, xb);
-      hi = std::max(xa, xb);
-    }
-    const int x0 = std::max(bx0, int(std::floor(lo - R)) - 1);
-    const int x1 = std::min(bx1, int(std::ceil(hi + R)) + 1);
+    int x0, x1;
+    if (!cap.span(yc, w, x0, x1)) continue;
+    x0 = std::max(x0, bx0);
+    x1 = std::min(x1, bx1);
     const std::size_t rowi = std::size_t(y) * std::size_t(w);
     if (y + 2 <= by1) {  // the rows are cache misses: start loading two rows ahead
       __builtin_prefetch(img + rowi + 2 * std::size_t(w) + x0);
@@ -229,49 +305,47 @@ void mark_segment(int n, const Vec2& a, const Vec2& b, double width, uint8_t* oc
   const double r = 0.5 * width, m = 1e-6;
   if (!a.allFinite() || !b.allFinite() || !std::isfinite(r) || r < 0) return;
   const double in2 = r > m ? (r - m) * (r - m) : -1.0, out2 = (r + m) * (r + m);
-  const int bx0 = std::max(0, int(std::floor(std::min(a.x(), b.x()) - r - 1)));
-  const int by0 = std::max(0, int(std::floor(std::min(a.y(), b.y()) - r - 1)));
-  const int bx1 = std::min(n - 1, int(std::ceil(std::max(a.x(), b.x()) + r + 1)));
-  const int by1 = std::min(n - 1, int(std::ceil(std::max(a.y(), b.y()) + r + 1)));
+  const int bx0 = std::max(0, ifloor(std::min(a.x(), b.x()) - r - 1));
+  const int by0 = std::max(0, ifloor(std::min(a.y(), b.y()) - r - 1));
+  const int bx1 = std::min(n - 1, iceil(std::max(a.x(), b.x()) + r + 1));
+  const int by1 = std::min(n - 1, iceil(std::max(a.y(), b.y()) + r + 1));
   if (bx0 > bx1 || by0 > by1) return;
   const Vec2 ab = b - a;
   const double l2 = ab.squaredNorm();
-  const double R = r + 1.5;
+  const CapsuleRows cap(a, b, r + m);
   for (int y = by0; y <= by1; ++y) {
     const double yc = y + 0.5;
-    double lo, hi;
-    if (ab.y() == 0.0) {
-      if (std::abs(a.y() - yc) > R) continue;
-      lo = std::min(a.x(), b.x());
-      hi = std::max(a.x(), b.x());
-    } else {
-      const double ta = (yc - R - a.y()) / ab.y(), tb = (yc + R - a.y()) / ab.y();
-      const double t0 = std::max(0.0, std::min(ta, tb)), t1 = std::min(1.0, std::max(ta, tb));
-      if (t0 > t1) continue;
-      const double xa = a.x() + t0 * ab.x(), xb = a.x() + t1 * ab.x();
-      lo = std::min(xa, xb);
-      hi = std::max(xa, xb);
-    }
-    const int x0 = std::max(bx0, int(std::floor(lo - R)) - 1);
-    const int x1 = std::min(bx1, int(std::ceil(hi + R)) + 1);
+    int x0, x1;
+    if (!cap.span(yc, n, x0, x1)) continue;
+    x0 = std::max(x0, bx0);
+    x1 = std::min(x1, bx1);
     uint8_t* row = occ + std::size_t(y) * std::size_t(n);
     if (y + 2 <= by1) {  // the rows are cache misses: start loading two rows ahead
       __builtin_prefetch(row + 2 * std::size_t(n) + x0);
       __builtin_prefetch(row + 2 * std::size_t(n) + x1);
     }
-    for (int x = x0; x <= x1; ++x) {
-      if (row[x]) continue;
+    // Texel x: true when it lies in the core (d <= r - 1e-6); otherwise marks it by the exact
+    // coverage rule.
+    auto core = [&](int x) {
       const Vec2 p(x + 0.5, yc);
       double t = l2 > 0 ? (p - a).dot(ab) / l2 : 0.0;
       t = std::clamp(t, 0.0, 1.0);
       const double d2 = (p - (a + t * ab)).squaredNorm();
-      if (d2 <= in2) {
-        row[x] = 1;
-      } else if (d2 < out2) {
+      if (d2 <= in2) return true;
+      if (d2 < out2) {
         const double cov = std::clamp(0.5 + r - std::sqrt(d2), 0.0, 1.0);  // raster.cpp's
         if (float(cov) * 1.0f >= 0.5f) row[x] = 1;
       }
-    }
+      return false;
+    };
+    // The core is a capsule, which is convex: its texel centres on a row form one run. Scan in
+    // from both ends of the span to the run and fill it without evaluating it.
+    int xl = x0;
+    while (xl <= x1 && !core(xl)) ++xl;
+    if (xl > x1) continue;
+    int xr = x1;
+    while (xr > xl && !core(xr)) --xr;
+    std::memset(row + xl, 1, std::size_t(xr - xl + 1));
   }
 }
 
@@ -346,9 +420,6 @@ TexelMap rasterize_texture_space(const Context& ctx, const geom::TriMesh& mesh, 
   TexelMap tm;
   tm.size = n;
   const std::size_t np = std::size_t(n) * n;
-  tm.tri.assign(np, -1);
-  tm.b1.assign(np, 0.f);
-  tm.b2.assign(np, 0.f);
   const std::size_t nf = mesh.uv_faces.size();
   std::vector<std::array<Vec2, 3>> tp(nf);
   double area3 = 0, area_t = 0;
@@ -362,29 +433,62 @@ TexelMap rasterize_texture_space(const Context& ctx, const geom::TriMesh& mesh, 
                        .norm();
   }
   tm.metres_per_texel = area_t > 0 ? std::sqrt(area3 / area_t) : 0.0;
+  // Per face: the barycentric coordinates as affine functions of the texel centre (two
+  // multiply-adds per texel instead of a solve) and the texel bounding box.
+  struct Face {
+    double a1x, a1y, a1c, a2x, a2y, a2c;
+    int x0, x1, y0, y1;
+  };
+  std::vector<Face> fc(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto& t = tp[f];
+    Face& F = fc[f];
+    const Vec2 e1 = t[1] - t[0], e2 = t[2] - t[0];
+    const double det = e1.x() * e2.y() - e1.y() * e2.x();
+    if (std::abs(det) < 1e-300) {  // degenerate in texture space: covers no texel
+      F.y0 = 1;
+      F.y1 = 0;
+      continue;
+    }
+    // b1 = (q x e2) / det, b2 = (e1 x q) / det with q = p - t0.
+    F.a1x = e2.y() / det;
+    F.a1y = -e2.x() / det;
+    F.a1c = -(F.a1x * t[0].x() + F.a1y * t[0].y());
+    F.a2x = -e1.y() / det;
+    F.a2y = e1.x() / det;
+    F.a2c = -(F.a2x * t[0].x() + F.a2y * t[0].y());
+    F.y0 = std::max(0, ifloor(std::min({t[0].y(), t[1].y(), t[2].y()}) - 0.5));
+    F.y1 = std::min(n - 1, iceil(std::max({t[0].y(), t[1].y(), t[2].y()}) - 0.5));
+    F.x0 = std::max(0, ifloor(std::min({t[0].x(), t[1].x(), t[2].x()}) - 0.5));
+    F.x1 = std::min(n - 1, iceil(std::max({t[0].x(), t[1].x(), t[2].x()}) - 0.5));
+  }
   // Bands of rows in parallel; within a band faces are drawn in order (last face wins on shared
-  // edges), so the result does not depend on the thread count.
+  // edges), so the result does not depend on the thread count. Each band also clears its rows
+  // (first touch on the thread that writes them) and lists its covered texels.
+  tm.tri.resize(np);
+  tm.b1.resize(np);
+  tm.b2.resize(np);
   constexpr int kBand = 32;
   const int bands = (n + kBand - 1) / kBand;
+  std::vector<std::vector<uint32_t>> band_cov;
+  band_cov.resize(std::size_t(bands));
   parallel_for(
       ctx, 0, std::size_t(bands),
       [&](std::size_t band) {
         const int ylo = int(band) * kBand, yhi = std::min(n, ylo + kBand);
+        const std::size_t i0 = std::size_t(ylo) * n, i1 = std::size_t(yhi) * n;
+        std::fill(tm.tri.begin() + i0, tm.tri.begin() + i1, -1);
+        std::fill(tm.b1.begin() + i0, tm.b1.begin() + i1, 0.f);
+        std::fill(tm.b2.begin() + i0, tm.b2.begin() + i1, 0.f);
         for (std::size_t f = 0; f < nf; ++f) {
-          const auto& t = tp[f];
-          const double miny = std::min({t[0].y(), t[1].y(), t[2].y()});
-          const double maxy = std::max({t[0].y(), t[1].y(), t[2].y()});
-          const int y0 = std::max(ylo, int(std::floor(miny - 0.5)));
-          const int y1 = std::min(yhi - 1, int(std::ceil(maxy - 0.5)));
-          if (y0 > y1) continue;
-          const double minx = std::min({t[0].x(), t[1].x(), t[2].x()});
-          const double maxx = std::max({t[0].x(), t[1].x(), t[2].x()});
-          const int x0 = std::max(0, int(std::floor(minx - 0.5)));
-          const int x1 = std::min(n - 1, int(std::ceil(maxx - 0.5)));
-          for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x) {
-              double b1, b2;
-              if (!barycentric(Vec2(x + 0.5, y + 0.5), t[0], t[1], t[2], b1, b2)) continue;
+          const Face& F = fc[f];
+          const int y0 = std::max(ylo, F.y0), y1 = std::min(yhi - 1, F.y1);
+          for (int y = y0; y <= y1; ++y) {
+            const double yc = y + 0.5;
+            const double r1 = F.a1y * yc + F.a1c, r2 = F.a2y * yc + F.a2c;
+            for (int x = F.x0; x <= F.x1; ++x) {
+              const double xc = x + 0.5;
+              const double b1 = F.a1x * xc + r1, b2 = F.a2x * xc + r2;
               const double eps = -1e-9;
               if (b1 < eps || b2 < eps || 1.0 - b1 - b2 < eps) continue;
               const std::size_t i = std::size_t(y) * n + x;
@@ -392,11 +496,17 @@ TexelMap rasterize_texture_space(const Context& ctx, const geom::TriMesh& mesh, 
               tm.b1[i] = float(b1);
               tm.b2[i] = float(b2);
             }
+          }
         }
+        auto& cov = band_cov[band];
+        for (std::size_t i = i0; i < i1; ++i)
+          if (tm.tri[i] >= 0) cov.push_back(uint32_t(i));
       },
       1);
-  for (std::size_t i = 0; i < np; ++i)
-    if (tm.tri[i] >= 0) tm.covered.push_back(uint32_t(i));
+  std::size_t total = 0;
+  for (const auto& c : band_cov) total += c.size();
+  tm.covered.reserve(total);
+  for (const auto& c : band_cov) tm.covered.insert(tm.covered.end(), c.begin(), c.end());
   return tm;
 }
 
@@ -451,7 +561,7 @@ class Carver {
   /// Direction d (texel space) at P by interpolating the three vertices of P's triangle (step 1);
   /// false when P is not on the mapped mesh.
   bool direction_at(const Vec2& P, Vec2& d) const {
-    const int x = int(std::floor(P.x())), y = int(std::floor(P.y()));
+    const int x = ifloor(P.x()), y = ifloor(P.y());
     if (!m_tm.inside(x, y)) return false;
     const int f = m_tm.tri[std::size_t(y) * m_tm.size + x];
     if (f < 0) return false;
@@ -466,12 +576,53 @@ class Carver {
     return true;
   }
 
+  void prefetch_texel(const Vec2& P) const {
+    const int x = ifloor(P.x()), y = ifloor(P.y());
+    if (m_tm.inside(x, y)) __builtin_prefetch(m_tm.tri.data() + std::size_t(y) * m_tm.size + x);
+  }
+
   bool occupied(const Vec2& P) const {
-    const int x = int(std::floor(P.x())), y = int(std::floor(P.y()));
+    const int x = ifloor(P.x()), y = ifloor(P.y());
     if (!m_tm.inside(x, y)) return true;
     return m_occ[std::size_t(y) * m_tm.size + x] != 0;
   }
   /// The carved height image and the binary occupancy image (§2.6.2 steps 5 and 6).
+  /// §2.6.2 step 5 for every recorded stroke (image::draw_line with Blend::Min, texel for
+  /// texel). Blending is order-dependent, so each band of rows applies all strokes that reach it
+  /// in walk order: the result is the sequential one for any thread count.
+  void carve_heights(const Context& ctx) {
+    const int n = m_tm.size;
+    constexpr int kBand = 64;
+    const int bands = (n + kBand - 1) / kBand;
+    std::vector<std::vector<uint32_t>> in_band;
+    in_band.resize(std::size_t(bands));
+    for (std::size_t k = 0; k < m_strokes.size(); ++k) {
+      const Stroke& st = m_strokes[k];
+      const double r = 0.5 * st.width;
+      const int y0 = std::clamp(ifloor(std::min(st.a.y(), st.b.y()) - r - 1), 0, n - 1);
+      const int y1 = std::clamp(iceil(std::max(st.a.y(), st.b.y()) + r + 1), 0, n - 1);
+      for (int b = y0 / kBand; b <= y1 / kBand; ++b) in_band[std::size_t(b)].push_back(uint32_t(k));
+    }
+    float* hgt = m_h.data();
+    parallel_for(
+        ctx, 0, std::size_t(bands),
+        [&](std::size_t b) {
+          const int ylo = int(b) * kBand, yhi = std::min(n, ylo + kBand);
+          for (uint32_t k : in_band[b]) {
+            const Stroke& st = m_strokes[k];
+            const float I = st.I;
+            visit_segment(
+                n, n, st.a, st.b, st.width, hgt,
+                [&](std::size_t i, double cov) {
+                  const float cf = float(cov);
+                  hgt[i] = hgt[i] + cf * (std::min(hgt[i], I) - hgt[i]);
+                },
+                ylo, yhi);
+          }
+        },
+        1);
+  }
+
   void write_images(image::ImageF& height, image::ImageF& img) const {
     std::memcpy(height.data(), m_h.data(), m_h.size() * sizeof(float));
     img.resize(m_tm.size, m_tm.size, 0.0f);
@@ -480,7 +631,7 @@ class Carver {
   }
   bool locked(const Vec2& P) const {
     if (!m_init) return false;
-    const int x = int(std::floor(P.x())), y = int(std::floor(P.y()));
+    const int x = ifloor(P.x()), y = ifloor(P.y());
     if (!m_tm.inside(x, y)) return false;
     return m_init->locked[std::size_t(y) * m_tm.size + x] != 0;
   }
@@ -512,18 +663,16 @@ class Carver {
           Q = P + t * (Q - P);
           n = 0;
         }
+        prefetch_texel(Q);     // the next step's triangle lookup, loaded while carving
         if (locked(Q)) n = 0;  // seam strip: copied from the neighbour, do not grow into it
-        // step 5: carve PQ on the height image with intensity I and width W_h
-        // (image::draw_line with Blend::Min, texel for texel)
-        const float I = float(fp.I);
-        float* hgt = m_h.data();
+        // step 5: carve PQ on the height image with intensity I and width W_h. Nothing in the
+        // walk reads the height image, so the strokes are recorded here and carved afterwards,
+        // in this order, by carve_heights() (parallel over row bands).
+        const double wh = fp.Wh * m_unit;
+        if (!P.allFinite() || !Q.allFinite() || !std::isfinite(wh) || wh < 0)
+          image::draw_line(m_out.height, P, Q, wh, float(fp.I), image::Blend::Min);  // throws
+        m_strokes.push_back({P, Q, wh, float(fp.I)});
         const int sz = m_tm.size;
-        if (!visit_segment(sz, sz, P, Q, fp.Wh * m_unit, hgt, [&](std::size_t i, double cov) {
-              const float cf = float(cov);
-              hgt[i] = hgt[i] + cf * (std::min(hgt[i], I) - hgt[i]);
-            }))
-          image::draw_line(m_out.height, P, Q, fp.Wh * m_unit, I, image::Blend::Min);  // throws
-                                                                                       // the error
         // step 6: record PQ on the occupancy image with value 1 and width W_o (Blend::Max of
         // the coverage; only whether it reaches 0.5 matters, see the constructor)
         mark_segment(sz, P, Q, fp.Wo * m_unit, m_occ.data());
@@ -556,11 +705,17 @@ class Carver {
   BigBuffer<float> m_h;                       // the height image while carving
   BigBuffer<uint8_t> m_occ;                   // occupancy: 1 = occupied (see the constructor)
   std::array<std::vector<Vec2>, 2> m_halves;  // the two halves of the current furrow
+  struct Stroke {
+    Vec2 a, b;
+    double width;
+    float I;
+  };
+  std::vector<Stroke> m_strokes;  // step 5's strokes in walk order (see carve_heights)
 };
 
 }  // namespace
 
-HeightField carve_furrows(const geom::TriMesh& mesh, const TexelMap& texels,
+HeightField carve_furrows(const Context& ctx, const geom::TriMesh& mesh, const TexelMap& texels,
                           std::vector<Vec2> directions, double unit_texels,
                           const FineWrinkleParams& p, uint64_t seed, const SeamInit* init) {
   p.validate();
@@ -601,6 +756,7 @@ HeightField carve_furrows(const geom::TriMesh& mesh, const TexelMap& texels,
       }
     }
   }
+  carver.carve_heights(ctx);
   // Binary occupancy, and the seam strip exactly as copied.
   carver.write_images(out.height, out.occupancy);
   if (init)
@@ -632,7 +788,7 @@ FineWrinkles generate_fine_wrinkles(const Context& ctx, const geom::TriMesh& mes
           std::vector<Vec2> dirs =
               interpolate_direction_field(mesh, all, fmt::format("fine_wrinkles.fields[{}]", k));
           w.fields[k] =
-              carve_furrows(mesh, w.texels, std::move(dirs), w.unit_texels, p,
+              carve_furrows(ctx, mesh, w.texels, std::move(dirs), w.unit_texels, p,
                             Rng::stream(ctx.seed(), 0xF1E1D000ULL + k).next_u64(), seams[k]);
         } catch (...) {
           errors[k] = std::current_exception();
@@ -708,7 +864,7 @@ SeamInit make_seam_init(const geom::TriMesh& mesh_a, const FineWrinkles& a, int 
   }
   // Furrow segments of A inside the strip, mapped into B's texel space (obstacles for step 4).
   auto map_point = [&](const Vec2f& pa, Vec2& pb) {
-    const int x = int(std::floor(pa.x())), y = int(std::floor(pa.y()));
+    const int x = ifloor(pa.x()), y = ifloor(pa.y());
     if (!a.texels.inside(x, y)) return false;
     const int f = a.texels.tri[std::size_t(y) * na + x];
     if (f < 0 || a_to_b[f] < 0) return false;

@@ -102,9 +102,11 @@ struct HeightField {
   int random_furrows = 0, fill_furrows = 0, failed_starts = 0, segments = 0;
 };
 
-/// §2.6.2: carves one field's furrows (sequential, deterministic for a seed). `directions` are
-/// per uv vertex (already interpolated). `unit_texels` is the resolved (2.5) unit.
-HeightField carve_furrows(const geom::TriMesh& mesh, const TexelMap& texels,
+/// §2.6.2: carves one field's furrows (the walk is sequential, deterministic for a seed; the
+/// height strokes of step 5 are then drawn in parallel over row bands, in walk order, so the
+/// images do not depend on the thread count). `directions` are per uv vertex (already
+/// interpolated). `unit_texels` is the resolved (2.5) unit.
+HeightField carve_furrows(const Context& ctx, const geom::TriMesh& mesh, const TexelMap& texels,
                           std::vector<Vec2> directions, double unit_texels,
                           const FineWrinkleParams& p, uint64_t seed,
                           const SeamInit* init = nullptr);

@@ -4,6 +4,7 @@
 
 #include "follicle/core/context.hpp"
 #include "follicle/core/error.hpp"
+#include "follicle/image/raster.hpp"
 #include "follicle/skin/fine_wrinkles_bando2002.hpp"
 #include "follicle/skin/wrinkle_shape_bando2002.hpp"
 
@@ -121,6 +122,43 @@ TEST(FineWrinkles, OccupancyOutsideMeshAndNoCrossings) {
   }
 }
 
+TEST(FineWrinkles, CarvedImagesAreTheStrokesOfTheFurrows) {
+  // With one magnitude everywhere every segment has the same I, W_h and W_o (2.5), so steps 5
+  // and 6 can be redone from the furrow polylines with image::draw_line: the carver's own
+  // stroke rasterizers (capsule spans, filled core runs) must give the same texels.
+  const auto m = grid(8);
+  Context ctx(1, 11);
+  auto p = small_params(160);
+  p.unit_texels = 1.7;  // W_h = 1.7 texels, W_o = 11.9 texels (m = 0.5)
+  const auto w = generate_fine_wrinkles(
+      ctx, m, {uniform_keys(m, Vec2(0.4, 0.3)), uniform_keys(m, Vec2(-0.1, 0.5))}, p);
+  for (int k = 0; k < 2; ++k) {
+    const HeightField& f = w.fields[k];
+    const double mag = f.directions[0].norm();
+    const FurrowParameters fp = furrow_parameters(mag, 0.0);
+    image::ImageF h(160, 160, 1.0f), occ(160, 160, 0.0f);
+    const auto& pl = f.furrows;
+    ASSERT_GT(pl.size(), 10u);
+    for (std::size_t a = 0; a < pl.size(); ++a)
+      for (uint32_t j = pl.offsets[a]; j + 1 < pl.offsets[a + 1]; ++j) {
+        const Vec2 P = pl.points[j].cast<double>(), Q = pl.points[j + 1].cast<double>();
+        image::draw_line(h, P, Q, fp.Wh * p.unit_texels, float(fp.I), image::Blend::Min);
+        image::draw_line(occ, P, Q, fp.Wo * p.unit_texels, 1.0f, image::Blend::Max);
+      }
+    // Polyline points are stored as floats (~1e-5 texel): allow that much in coverage.
+    int height_off = 0, occ_off = 0, carved = 0;
+    for (int y = 0; y < 160; ++y)
+      for (int x = 0; x < 160; ++x) {
+        if (std::abs(h.at(x, y) - f.height.at(x, y)) > 1e-3f) ++height_off;
+        if (f.height.at(x, y) < 1.0f) ++carved;
+        if ((occ.at(x, y) >= 0.5f) != (f.occupancy.at(x, y) >= 0.5f)) ++occ_off;
+      }
+    EXPECT_GT(carved, 2000) << "field " << k;
+    EXPECT_EQ(height_off, 0) << "field " << k;
+    EXPECT_LE(occ_off, 20) << "field " << k;
+  }
+}
+
 TEST(FineWrinkles, NoFurrowStartsInsideOccupiedTexelsAndFillPassCovers) {
   const auto m = grid(8);
   Context ctx(1, 3);
@@ -138,7 +176,7 @@ TEST(FineWrinkles, NoFurrowStartsInsideOccupiedTexelsAndFillPassCovers) {
   SeamInit all;
   all.height.resize(128, 128, 1.0f);
   all.locked.assign(128 * 128, 1);
-  const auto f = carve_furrows(m, w.texels, w.fields[0].directions, 1.0, p, 11, &all);
+  const auto f = carve_furrows(ctx, m, w.texels, w.fields[0].directions, 1.0, p, 11, &all);
   EXPECT_EQ(f.random_furrows + f.fill_furrows, 0);
   EXPECT_EQ(f.segments, 0);
 }
@@ -317,5 +355,5 @@ TEST(FineWrinkles, BadInputs) {
   no_uv.uvs.clear();
   no_uv.uv_faces.clear();
   EXPECT_THROW(generate_fine_wrinkles(ctx, no_uv, {}, p), Error);
-  EXPECT_THROW(carve_furrows(m, rasterize_texture_space(ctx, m, 64), {}, 1.0, p, 1), Error);
+  EXPECT_THROW(carve_furrows(ctx, m, rasterize_texture_space(ctx, m, 64), {}, 1.0, p, 1), Error);
 }
