@@ -1,7 +1,8 @@
 // follicle export SCENE --maps DIR [--frames A-B]: the fine-wrinkle relief of the scene's hand
-// as height, normal and displacement maps (float EXR + 8-bit PNG, skin::export_wrinkle_maps) for
-// the rest state (DIR/hand_rest_*) and every frame of the range (DIR/hand_frame_NNNN_*). Every
-// file is written atomically (temp file + rename).
+// and of every skin rig with "fine" as height, normal and displacement maps (float EXR + 8-bit
+// PNG, skin::export_wrinkle_maps) for the rest state (DIR/hand_rest_*, DIR/skinR_rest_*) and
+// every frame of the range (DIR/hand_frame_NNNN_*, DIR/skinR_frame_NNNN_*). Every file is
+// written atomically (temp file + rename).
 #include <fmt/format.h>
 
 #include <cctype>
@@ -19,10 +20,10 @@ int run_export_maps(const GlobalOptions& g, const ExportArgs& a) {
   int first = -1, last = -1;
   parse_frames(a.frames, first, last);
   auto session = scene::Session::load(a.scene, *ctx);
-  if (!session.scene().hand)
+  if (!session.has_wrinkle_maps())
     fail_at(a.scene,
-            "the scene has no fine-wrinkle source for --maps (a \"hand\" section); nothing to "
-            "export");
+            "the scene has no fine-wrinkle source for --maps (a \"hand\" section or \"fine\" "
+            "in a skin rig); nothing to export");
   const int count = session.frame_count();
   if (first < 0) {
     first = 0;

@@ -95,11 +95,15 @@ class Session {
   skin::HandFrame hand_frame(int frame);
   /// Finger flexion in [0, 1] of the hand at `frame`.
   double hand_flexion(int frame) const;
-  /// Writes the fine-wrinkle relief of the hand as height, normal and displacement maps (float
-  /// EXR + 8-bit PNG, skin::export_wrinkle_maps) into `dir`: the rest state when frame < 0
-  /// (stem "hand_rest"), else the modulated relief at that frame (stem "hand_frame_NNNN").
-  /// Returns the stem written. Throws when the scene has no fine-wrinkle source.
-  std::string export_wrinkle_maps(const std::filesystem::path& dir, int frame);
+  /// Writes the fine-wrinkle relief of every fine-wrinkle source as height, normal and
+  /// displacement maps (float EXR + 8-bit PNG, skin::export_wrinkle_maps) into `dir`: the hand
+  /// (stem "hand_...") and each skin rig with "fine" (stem "skinR_..." for skin[R]); the rest
+  /// state when frame < 0 ("..._rest"), else the modulated relief at that frame
+  /// ("..._frame_NNNN"). Returns the stems written. Throws when the scene has no fine-wrinkle
+  /// source (see has_wrinkle_maps).
+  std::vector<std::string> export_wrinkle_maps(const std::filesystem::path& dir, int frame);
+  /// True when the scene has a fine-wrinkle source for export_wrinkle_maps.
+  bool has_wrinkle_maps() const;
   /// LCP hair particles ("lcp" section) in the world frame with directions t_i at `frame`,
   /// simulated deterministically from frame 0 (consecutive frames continue from the kept state).
   /// Throws when there is no lcp section or the simulation blows up.

@@ -10,6 +10,7 @@
 #include "follicle/core/log.hpp"
 #include "follicle/scene/hand_runtime.hpp"
 #include "follicle/scene/session.hpp"
+#include "follicle/scene/skin_runtime.hpp"
 #include "follicle/skin/wrinkle_maps.hpp"
 
 namespace follicle::scene {
@@ -81,31 +82,64 @@ void Session::add_hand_items(render::RenderScene& rs, int frame) {
   rs.meshes.push_back(std::move(item));
 }
 
-std::string Session::export_wrinkle_maps(const std::filesystem::path& dir, int frame) {
-  if (!m_scene.hand)
+bool Session::has_wrinkle_maps() const {
+  if (m_scene.hand) return true;
+  return std::any_of(m_scene.skin.begin(), m_scene.skin.end(),
+                     [](const SkinSpec& s) { return s.fine.has_value(); });
+}
+
+std::vector<std::string> Session::export_wrinkle_maps(const std::filesystem::path& dir, int frame) {
+  if (!has_wrinkle_maps())
     fail_at(m_source,
-            "the scene has no fine-wrinkle source to export maps from (add a \"hand\" section)");
-  auto& rt = hand_rt(m_hand, m_scene, m_source, resolve(m_scene.hand->makehuman), *m_ctx);
-  const skin::HandRig& rig = *rt.rig;
-  image::ImageF relief;
-  std::string stem;
-  if (frame < 0) {
-    rig.fine_animator().rest_relief(*m_ctx, relief);
-    stem = "hand_rest";
-  } else {
-    if (frame >= frame_count())
-      fail_at(m_source, "frame {} is past the scene's last frame {}", frame, frame_count() - 1);
-    skin::HandState s;
-    rig.update(*m_ctx, hand_flexion(frame), s, skin::HandUpdateOptions{});
-    relief = std::move(s.relief);
-    stem = fmt::format("hand_frame_{:04d}", frame);
+            "the scene has no fine-wrinkle source to export maps from (add a \"hand\" section "
+            "or \"fine\" to a skin rig)");
+  if (frame >= frame_count())
+    fail_at(m_source, "frame {} is past the scene's last frame {}", frame, frame_count() - 1);
+  auto suffix = [&] {
+    return frame < 0 ? std::string("rest") : fmt::format("frame_{:04d}", frame);
+  };
+  std::vector<std::string> stems;
+  if (m_scene.hand) {
+    auto& rt = hand_rt(m_hand, m_scene, m_source, resolve(m_scene.hand->makehuman), *m_ctx);
+    const skin::HandRig& rig = *rt.rig;
+    image::ImageF relief;
+    if (frame < 0) {
+      rig.fine_animator().rest_relief(*m_ctx, relief);
+    } else {
+      skin::HandState s;
+      rig.update(*m_ctx, hand_flexion(frame), s, skin::HandUpdateOptions{});
+      relief = std::move(s.relief);
+    }
+    skin::MapExportInfo info;
+    info.depth_m = rig.relief_depth_m();
+    info.metres_per_texel = rig.fine_animator().metres_per_texel();
+    info.strength = rig.params().bump_strength;
+    stems.push_back("hand_" + suffix());
+    skin::export_wrinkle_maps(*m_ctx, dir, stems.back(), relief, info);
   }
-  skin::MapExportInfo info;
-  info.depth_m = rig.relief_depth_m();
-  info.metres_per_texel = rig.fine_animator().metres_per_texel();
-  info.strength = rig.params().bump_strength;
-  skin::export_wrinkle_maps(*m_ctx, dir, stem, relief, info);
-  return stem;
+  for (std::size_t ri = 0; ri < m_scene.skin.size(); ++ri) {
+    const SkinSpec& spec = m_scene.skin[ri];
+    if (!spec.fine) continue;
+    // The relief in metres (rest: the rig's state at frame 0 builds the fields; the rest relief
+    // is M = r everywhere, i.e. no deformation).
+    (void)skin_fine_relief(ri, std::max(frame, 0));
+    const auto& r = skin_runtime().rigs[ri];
+    image::ImageF relief;
+    if (frame < 0) {
+      r.fine->rest_relief(*m_ctx, relief);
+    } else {
+      relief = *skin_fine_relief(ri, frame);
+      const float inv = r.fine_depth_m > 0 ? float(1.0 / r.fine_depth_m) : 0.0f;
+      for (float& x : relief.storage()) x *= inv;  // metres -> relief units
+    }
+    skin::MapExportInfo info;
+    info.depth_m = r.fine_depth_m;
+    info.metres_per_texel = r.fine->metres_per_texel();
+    info.strength = spec.fine->bump_strength;
+    stems.push_back(fmt::format("skin{}_{}", ri, suffix()));
+    skin::export_wrinkle_maps(*m_ctx, dir, stems.back(), relief, info);
+  }
+  return stems;
 }
 
 }  // namespace follicle::scene

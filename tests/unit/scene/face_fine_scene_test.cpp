@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "follicle/core/error.hpp"
+#include "follicle/image/image_io.hpp"
 #include "follicle/scene/session.hpp"
 #include "scene_test_util.hpp"
 #include "testing/testing.hpp"
@@ -152,4 +153,32 @@ TEST(FaceFineScene, BadFineKeysFailWithJsonPath) {
   e = relief_error(j);
   EXPECT_THAT(e, HasSubstr("skin[0].fine.field0[0].vertex"));
   EXPECT_THAT(e, HasSubstr("uv vertices"));
+}
+
+TEST(FaceFineScene, ExportMapsWritesTheFaceRelief) {
+  // `follicle export --maps` on a face with "fine": rest and frame maps of skin[0], the frame's
+  // height map equal to the material's relief (metres -> relief units, + 1).
+  Context ctx(2);
+  auto s = Session::from_json(forehead(), scenes_dir(), "f.json", ctx);
+  ASSERT_TRUE(s.has_wrinkle_maps());
+  const auto dir = test::scratch_dir("face_maps");
+  EXPECT_EQ(s.export_wrinkle_maps(dir, -1), std::vector<std::string>{"skin0_rest"});
+  EXPECT_EQ(s.export_wrinkle_maps(dir, 0), std::vector<std::string>{"skin0_frame_0000"});
+  const auto rest = image::read_exr_gray(dir / "skin0_rest_height.exr");
+  const auto frame = image::read_exr_gray(dir / "skin0_frame_0000_height.exr");
+  ASSERT_EQ(rest.width(), 256);
+  ASSERT_EQ(frame.width(), 256);
+  EXPECT_EQ(image::read_png_rgba(dir / "skin0_frame_0000_normal.png").width(), 256);
+  const auto relief = s.skin_fine_relief(0, 0);
+  ASSERT_TRUE(relief);
+  const double depth = 60e-6;  // fine.depth_m default
+  double worst = 0, carved = 0;
+  for (std::size_t i = 0; i < frame.storage().size(); ++i) {
+    const double want = relief->storage()[i] / depth + 1.0;
+    worst = std::max(worst, std::abs(frame.storage()[i] - want));
+    carved = std::min(carved, double(rest.storage()[i]) - 1.0);
+  }
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_LT(carved, -0.1);                     // the rest relief has furrows
+  EXPECT_GT(max_abs_diff(rest, frame), 1e-3);  // the troubled face modulates them
 }

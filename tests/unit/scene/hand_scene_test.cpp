@@ -113,8 +113,8 @@ TEST(HandScene, ExportMapsWritesReadableImagesOfTheMapSize) {
   Context ctx(2);
   auto s = Session::from_json(small_hand("hand_flexion_anim", 20), scenes_dir(), "anim", ctx);
   const auto dir = test::scratch_dir("hand_maps");
-  EXPECT_EQ(s.export_wrinkle_maps(dir, -1), "hand_rest");
-  EXPECT_EQ(s.export_wrinkle_maps(dir, 15), "hand_frame_0015");
+  EXPECT_EQ(s.export_wrinkle_maps(dir, -1), std::vector<std::string>{"hand_rest"});
+  EXPECT_EQ(s.export_wrinkle_maps(dir, 15), std::vector<std::string>{"hand_frame_0015"});
   for (const char* stem : {"hand_rest", "hand_frame_0015"}) {
     for (const char* kind : {"height", "displacement"}) {
       const auto base = dir / (std::string(stem) + "_" + kind);
