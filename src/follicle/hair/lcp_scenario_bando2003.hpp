@@ -25,18 +25,24 @@ namespace follicle::hair {
 /// the front of the crown (so the hair is combed back and down) and the shake pivot in the neck.
 struct LcpMeshHeadParams {
   // Four Catmull-Rom control polygons forming a closed loop (curve k ends where curve k+1 starts):
-  // curve0 -> v = 0 (nape, left to right), curve1 -> u = 1 (right side, up), curve2 -> v = 1
-  // (crown, right to left), curve3 -> u = 0 (left side, down). Points near the mesh surface.
+  // curve0 -> v = 0 (nape, left to right), curve1 -> u = 1 (right side, up behind and over the
+  // ear to the temple), curve2 -> v = 1 (front hairline, right to left), curve3 -> u = 0 (left
+  // side, down). Points near the mesh surface; the default is the whole scalp of the default
+  // head, nape to hairline.
   std::vector<Vec3> curve0{{0.055, 0.03, -0.062},
                            {0.03, 0.012, -0.068},
                            {0.0, 0.008, -0.068},
                            {-0.03, 0.012, -0.068},
                            {-0.055, 0.03, -0.062}};
   std::vector<Vec3> curve1{
-      {-0.055, 0.03, -0.062}, {-0.064, 0.08, -0.06}, {-0.06, 0.13, -0.04}, {-0.045, 0.168, 0.0}};
-  std::vector<Vec3> curve2{{-0.045, 0.168, 0.0}, {0.0, 0.182, 0.03}, {0.045, 0.168, 0.0}};
+      {-0.055, 0.03, -0.062}, {-0.066, 0.08, -0.05}, {-0.068, 0.125, -0.01}, {-0.055, 0.145, 0.05}};
+  std::vector<Vec3> curve2{{-0.055, 0.145, 0.05},
+                           {-0.03, 0.157, 0.07},
+                           {0.0, 0.16, 0.076},
+                           {0.03, 0.157, 0.07},
+                           {0.055, 0.145, 0.05}};
   std::vector<Vec3> curve3{
-      {0.045, 0.168, 0.0}, {0.06, 0.13, -0.04}, {0.064, 0.08, -0.06}, {0.055, 0.03, -0.062}};
+      {0.055, 0.145, 0.05}, {0.068, 0.125, -0.01}, {0.066, 0.08, -0.05}, {0.055, 0.03, -0.062}};
   Vec3 whirl_point{0.0, 0.185, 0.06};  // [m] the nearest scalp vertex is the whirl of (3.4)
   Vec3 pivot{0.0, 0.0, -0.01};         // [m] centre of the head shake (about +y)
   // A box for the torso below the mesh (collision only, not drawn); the default head mesh already

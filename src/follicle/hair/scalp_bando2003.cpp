@@ -173,6 +173,47 @@ Scalp Scalp::trim(const geom::TriMesh& head, const ScalpCurves& curves, const Sc
   }
   if (best < 0 || best_size < 2)
     fail_at("scalp.curves", "the curves enclose no faces of the head mesh");
+  // 4b. Fill holes: a scalp reaching the hairline bends through more than the loop's plane can
+  // see, and faces there that turn away from the plane's normal leave islands inside the
+  // selection. Every edge-connected group of unselected faces except the largest (the rest of
+  // the head) is a hole and joins the scalp.
+  {
+    std::map<std::pair<int, int>, std::vector<uint32_t>> all_edges;
+    for (std::size_t f = 0; f < nf; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
+        all_edges[{std::min(a, b), std::max(a, b)}].push_back(uint32_t(f));
+      }
+    std::vector<int> out_comp(nf, -1);
+    std::vector<int> out_size;
+    for (std::size_t f0 = 0; f0 < nf; ++f0) {
+      if (comp[f0] == best || out_comp[f0] >= 0) continue;
+      const int id = int(out_size.size());
+      int size = 0;
+      std::vector<uint32_t> stack{uint32_t(f0)};
+      out_comp[f0] = id;
+      while (!stack.empty()) {
+        const uint32_t f = stack.back();
+        stack.pop_back();
+        ++size;
+        for (int k = 0; k < 3; ++k) {
+          const int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
+          for (uint32_t g : all_edges[{std::min(a, b), std::max(a, b)}])
+            if (comp[g] != best && out_comp[g] < 0) {
+              out_comp[g] = id;
+              stack.push_back(g);
+            }
+        }
+      }
+      out_size.push_back(size);
+    }
+    if (!out_size.empty()) {
+      const int outside =
+          int(std::max_element(out_size.begin(), out_size.end()) - out_size.begin());
+      for (std::size_t f = 0; f < nf; ++f)
+        if (out_comp[f] >= 0 && out_comp[f] != outside) comp[f] = best;
+    }
+  }
 
   Scalp s;
   s.m_params = p;

@@ -1,6 +1,6 @@
 // LCP hair (Bando 2003 ch. 3) on the Lee Perry-Smith head mesh: the scalp trimmed by the four
-// default Catmull-Rom curves (§3.3.1) lies on the back and top of the head, and during a head
-// shake the voxel-plane body collision (§3.5) keeps every particle outside the head (signed
+// default Catmull-Rom curves (§3.3.1) covers the head from the nape to the hairline, and during a
+// head shake the voxel-plane body collision (§3.5) keeps every particle outside the head (signed
 // distance from the closest mesh point, Embree query, sign from the interpolated normal).
 #include <gtest/gtest.h>
 
@@ -74,19 +74,22 @@ ShakeResult shake(bool body_collision, double seconds) {
 
 }  // namespace
 
-TEST(LcpMeshHead, ScalpCoversTheBackAndTopOfTheHead) {
+TEST(LcpMeshHead, ScalpCoversTheHeadFromNapeToHairline) {
   Context ctx(2, 3);
   const geom::TriMesh head = lee_perry_smith();
   LcpScenarioParams sp;
   sp.spacing = 0.02;
   LcpScenario sc(ctx, sp, {}, &head);
   const Scalp& s = sc.scalp();
-  EXPECT_GT(s.area(), 0.02);  // about a third of a head of radius 0.09 m
-  EXPECT_LT(s.area(), 0.06);
+  EXPECT_GT(s.area(), 0.03);  // about half of a head of radius 0.09 m
+  EXPECT_LT(s.area(), 0.07);
+  double front = -1;
   for (const Vec3& p : s.mesh().positions) {
-    EXPECT_LT(p.z(), 0.05);   // behind the forehead hairline
-    EXPECT_GT(p.y(), -0.01);  // above the nape
+    EXPECT_FALSE(p.y() < 0.13 && p.z() > 0.05);  // not the forehead or the face
+    EXPECT_GT(p.y(), -0.01);                     // above the nape
+    front = std::max(front, p.z());
   }
+  EXPECT_GT(front, 0.065);  // reaches the front hairline
   EXPECT_GT(sc.body().num_planes(), 100u);
   // Every root lies at most s_r + spacing beneath the scalp (roots are fixed to the head).
   const geom::MeshQuery q(head);
