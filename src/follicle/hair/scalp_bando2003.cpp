@@ -33,6 +33,51 @@ Vec2 square_point(int curve, double t) {
   }
 }
 
+/// Edge-connected components of the faces with member[f] != 0 (id -1 for the others).
+struct FaceComponents {
+  std::vector<int> id;
+  std::vector<int> size;
+  int largest() const {
+    return size.empty() ? -1 : int(std::max_element(size.begin(), size.end()) - size.begin());
+  }
+};
+
+FaceComponents face_components(const geom::TriMesh& m, const std::vector<char>& member) {
+  const std::size_t nf = m.faces.size();
+  std::map<std::pair<int, int>, std::vector<uint32_t>> edge_faces;
+  for (std::size_t f = 0; f < nf; ++f) {
+    if (!member[f]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const int a = m.faces[f][k], b = m.faces[f][(k + 1) % 3];
+      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(uint32_t(f));
+    }
+  }
+  FaceComponents c;
+  c.id.assign(nf, -1);
+  for (std::size_t f0 = 0; f0 < nf; ++f0) {
+    if (!member[f0] || c.id[f0] >= 0) continue;
+    const int id = int(c.size.size());
+    int size = 0;
+    std::vector<uint32_t> stack{uint32_t(f0)};
+    c.id[f0] = id;
+    while (!stack.empty()) {
+      const uint32_t f = stack.back();
+      stack.pop_back();
+      ++size;
+      for (int k = 0; k < 3; ++k) {
+        const int a = m.faces[f][k], b = m.faces[f][(k + 1) % 3];
+        for (uint32_t g : edge_faces[{std::min(a, b), std::max(a, b)}])
+          if (c.id[g] < 0) {
+            c.id[g] = id;
+            stack.push_back(g);
+          }
+      }
+    }
+    c.size.push_back(size);
+  }
+  return c;
+}
+
 }  // namespace
 
 Scalp Scalp::trim(const geom::TriMesh& head, const ScalpCurves& curves, const ScalpParams& p) {
@@ -137,83 +182,21 @@ Scalp Scalp::trim(const geom::TriMesh& head, const ScalpCurves& curves, const Sc
     if (!grown) break;
   }
   // 4. Keep the largest edge-connected component.
-  std::map<std::pair<int, int>, std::vector<uint32_t>> edge_faces;
-  for (std::size_t f = 0; f < nf; ++f) {
-    if (!sel[f]) continue;
-    for (int k = 0; k < 3; ++k) {
-      int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
-      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(uint32_t(f));
-    }
-  }
-  std::vector<int> comp(nf, -1);
-  int best = -1, best_size = 0, ncomp = 0;
-  for (std::size_t f0 = 0; f0 < nf; ++f0) {
-    if (!sel[f0] || comp[f0] >= 0) continue;
-    int size = 0;
-    std::vector<uint32_t> stack{uint32_t(f0)};
-    comp[f0] = ncomp;
-    while (!stack.empty()) {
-      const uint32_t f = stack.back();
-      stack.pop_back();
-      ++size;
-      for (int k = 0; k < 3; ++k) {
-        int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
-        for (uint32_t g : edge_faces[{std::min(a, b), std::max(a, b)}])
-          if (comp[g] < 0) {
-            comp[g] = ncomp;
-            stack.push_back(g);
-          }
-      }
-    }
-    if (size > best_size) {
-      best_size = size;
-      best = ncomp;
-    }
-    ++ncomp;
-  }
-  if (best < 0 || best_size < 2)
+  const FaceComponents in = face_components(head, sel);
+  const int best = in.largest();
+  if (best < 0 || in.size[std::size_t(best)] < 2)
     fail_at("scalp.curves", "the curves enclose no faces of the head mesh");
+  std::vector<int> comp = in.id;
   // 4b. Fill holes: a scalp reaching the hairline bends through more than the loop's plane can
   // see, and faces there that turn away from the plane's normal leave islands inside the
-  // selection. Every edge-connected group of unselected faces except the largest (the rest of
+  // selection. Every edge-connected group of the other faces except the largest (the rest of
   // the head) is a hole and joins the scalp.
-  {
-    std::map<std::pair<int, int>, std::vector<uint32_t>> all_edges;
-    for (std::size_t f = 0; f < nf; ++f)
-      for (int k = 0; k < 3; ++k) {
-        const int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
-        all_edges[{std::min(a, b), std::max(a, b)}].push_back(uint32_t(f));
-      }
-    std::vector<int> out_comp(nf, -1);
-    std::vector<int> out_size;
-    for (std::size_t f0 = 0; f0 < nf; ++f0) {
-      if (comp[f0] == best || out_comp[f0] >= 0) continue;
-      const int id = int(out_size.size());
-      int size = 0;
-      std::vector<uint32_t> stack{uint32_t(f0)};
-      out_comp[f0] = id;
-      while (!stack.empty()) {
-        const uint32_t f = stack.back();
-        stack.pop_back();
-        ++size;
-        for (int k = 0; k < 3; ++k) {
-          const int a = head.faces[f][k], b = head.faces[f][(k + 1) % 3];
-          for (uint32_t g : all_edges[{std::min(a, b), std::max(a, b)}])
-            if (comp[g] != best && out_comp[g] < 0) {
-              out_comp[g] = id;
-              stack.push_back(g);
-            }
-        }
-      }
-      out_size.push_back(size);
-    }
-    if (!out_size.empty()) {
-      const int outside =
-          int(std::max_element(out_size.begin(), out_size.end()) - out_size.begin());
-      for (std::size_t f = 0; f < nf; ++f)
-        if (out_comp[f] >= 0 && out_comp[f] != outside) comp[f] = best;
-    }
-  }
+  std::vector<char> rest(nf, 0);
+  for (std::size_t f = 0; f < nf; ++f) rest[f] = comp[f] != best;
+  const FaceComponents out = face_components(head, rest);
+  const int outside = out.largest();
+  for (std::size_t f = 0; f < nf; ++f)
+    if (out.id[f] >= 0 && out.id[f] != outside) comp[f] = best;
 
   Scalp s;
   s.m_params = p;

@@ -193,10 +193,13 @@ struct RenderSettings {
   int shadow_map_size = 2048;
   bool transparent_background = false;  // background alpha 0 instead of 1 (output alpha = coverage)
   int hair_light_map_size = 512;  // light-view buffer of the hair splat pass (Bando 2003 §3.4)
-  /// Depth slices of the hair light-view pass: particles are sorted by depth from the light and
-  /// cut into this many equal batches; each batch reads the light reaching it, then is splatted
-  /// (docs/adr/0003-splat-light-pass.md). >= the particle count reproduces the paper's
-  /// per-particle read exactly.
+  /// Hair light-view pass (Bando 2003 §3.4 lines 6-12): "cpu" reads and splats exactly particle
+  /// by particle on the CPU (docs/adr/0005-cpu-splat-light-pass.md); "gpu" batches the reads in
+  /// `hair_light_slices` depth slices on the GPU (docs/adr/0003-splat-light-pass.md).
+  std::string hair_light_pass = "cpu";
+  /// "gpu" pass only: depth slices; particles are sorted by depth from the light and cut into
+  /// this many equal batches; each batch reads the light reaching it, then is splatted.
+  /// >= the particle count reproduces the paper's per-particle read exactly.
   int hair_light_slices = 128;
 
   template <class V>
@@ -208,10 +211,17 @@ struct RenderSettings {
     v("transparent_background", transparent_background, ParamInfo{"background alpha 0", ""});
     v("hair_light_map_size", hair_light_map_size,
       ParamInfo{"hair light-view buffer resolution", "px", 16, 16384});
+    v("hair_light_pass", hair_light_pass,
+      ParamInfo{"hair light-view pass: \"cpu\" (exact per particle) or \"gpu\" (depth slices)"});
     v("hair_light_slices", hair_light_slices,
-      ParamInfo{"depth slices of the hair light-view pass", "", 1, 1 << 24});
+      ParamInfo{"depth slices of the \"gpu\" hair light-view pass", "", 1, 1 << 24});
   }
-  void validate() const { validate_params(*this, "render"); }
+  void validate() const {
+    validate_params(*this, "render");
+    if (hair_light_pass != "cpu" && hair_light_pass != "gpu")
+      fail_at("render.hair_light_pass", "unknown value \"{}\"; expected \"cpu\" or \"gpu\"",
+              hair_light_pass);
+  }
 };
 
 }  // namespace follicle::render

@@ -1,16 +1,20 @@
-// GL 3.3 hair splat passes of Bando 2003 §3.4 (see splat_gl.hpp and
-// docs/adr/0003-splat-light-pass.md).
+// GL 3.3 hair splat passes of Bando 2003 §3.4 (see splat_gl.hpp).
 //
-// The paper's light pass reads the framebuffer back once per particle (pseudo-code line 9)
-// before splatting it (line 10). A CPU readback per particle stalls the pipeline N times
-// (thousands of glReadPixels per frame); we keep the read on the GPU instead: particles sorted
-// by depth from the light are cut into `hair_light_slices` consecutive batches, and for every
-// batch a point draw writes, for each of its particles, the light buffer value at the
-// particle (and the objects' shadow-map visibility) into the particle's texel of an intensity
-// texture, then the batch's billboards are splatted into the light buffer. Particles read the
-// light attenuated by every particle of the earlier (nearer) batches; only particles in the
-// same batch do not shadow each other. With as many slices as particles this is the paper's
-// algorithm exactly (tested); the default 128 slices costs 256 small draws.
+// Light pass (pseudo-code lines 6-12), RenderSettings::hair_light_pass:
+// - "cpu" (default; docs/adr/0005-cpu-splat-light-pass.md): the objects' shadow-map
+//   visibility (line 8) does not depend on the hair, so one GL_POINTS draw of the gather program
+//   writes it for every particle into the intensity texture, read back with one glReadPixels;
+//   splat_light_pass_bando2003() then runs the paper's loop exactly, particle by particle, on
+//   the CPU; the final buffer is uploaded as the light map and (visibility, light read) per
+//   particle into the intensity texture the view pass reads.
+// - "gpu" (docs/adr/0003-splat-light-pass.md): the reads stay on the GPU: particles sorted by
+//   depth from the light are cut into `hair_light_slices` consecutive batches, and for every
+//   batch a point draw writes, for each of its particles, the light buffer value at the
+//   particle (and the objects' shadow-map visibility) into the particle's texel of the
+//   intensity texture, then the batch's billboards are splatted into the light buffer.
+//   Particles in the same batch do not shadow each other; with as many slices as particles
+//   this is the paper's algorithm (tested against the CPU pass). 2 draws per slice, each a
+//   framebuffer switch that flushes llvmpipe's rasteriser.
 #include "follicle/render/splat_gl.hpp"
 
 #include <algorithm>
@@ -91,7 +95,9 @@ SplatPassGl::SplatPassGl() {
   glGenBuffers(1, &m_order_buf);
   glGenTextures(1, &m_particle_tbo);
   glGenTextures(1, &m_order_tbo);
-  m_default_tex = upload_hair_texture(make_hair_texture());
+  const image::ImageRGBA8 hair = make_hair_texture();
+  m_default_tex = upload_hair_texture(hair);
+  m_cpu_default_tex = std::make_unique<SplatAlphaTexture>(hair);
   check_gl("hair splat initialisation");
 }
 
@@ -228,6 +234,15 @@ GLuint SplatPassGl::hair_texture() {
   return m_custom_tex;
 }
 
+const SplatAlphaTexture& SplatPassGl::cpu_hair_texture() {
+  if (!m_custom_tex_src) return *m_cpu_default_tex;
+  if (!m_cpu_custom_tex || m_cpu_custom_src != m_custom_tex_src) {
+    m_cpu_custom_tex = std::make_unique<SplatAlphaTexture>(*m_custom_tex_src);
+    m_cpu_custom_src = m_custom_tex_src;
+  }
+  return *m_cpu_custom_tex;
+}
+
 void SplatPassGl::ensure_intensity(std::size_t n) {
   const int w = int(std::min<std::size_t>(n, kIntensityWidth));
   const int h = int((n + kIntensityWidth - 1) / kIntensityWidth);
@@ -270,17 +285,24 @@ void SplatPassGl::bind_common(GLuint prog, int order_base) {
 void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao) {
   m_light_done = false;
   if (m_count == 0) return;
+  settings.validate();
   const std::size_t n = m_count;
+  m_cpu_particles.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* r = &m_data[16 * i];
+    LightSplatParticle& p = m_cpu_particles[i];
+    p.pos = Vec3(r[0], r[1], r[2]);
+    p.half_w = r[3];
+    p.t = Vec3(r[4], r[5], r[6]);
+    p.half_l = r[7];
+    p.alpha = r[11];
+    p.min_sin = r[12];
+    p.casts = r[13] > 0.5f;
+    p.opacity_scale = m_items[std::size_t(r[15] + 0.5f)].item->splat.shadow_opacity_scale;
+    p.vis = 1;
+  }
   // Line 7: ascending depth from the light (stable: ties keep input order -> deterministic).
-  std::vector<double> depth(n);
-  for (std::size_t i = 0; i < n; ++i)
-    depth[i] = light.travel.x() * m_data[16 * i] + light.travel.y() * m_data[16 * i + 1] +
-               light.travel.z() * m_data[16 * i + 2];
-  std::vector<int32_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
-    return depth[std::size_t(a)] < depth[std::size_t(b)];
-  });
+  const std::vector<int32_t> order = splat_light_order(light.travel, m_cpu_particles);
   glBindBuffer(GL_TEXTURE_BUFFER, m_order_buf);
   glBufferSubData(GL_TEXTURE_BUFFER, 0, GLsizeiptr(n * sizeof(int32_t)), order.data());
   glBindBuffer(GL_TEXTURE_BUFFER, 0);
@@ -308,6 +330,64 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
   gl::set_f(m_gather_prog, "uShadowTexel", light.shadow_texel);
   gl::set_f(m_gather_prog, "uShadowBias", light.shadow_bias);
   gl::set_i(m_gather_prog, "uIntensityHeight", m_intensity_h);
+
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glBindVertexArray(empty_vao);
+  if (settings.hair_light_pass == "gpu")
+    light_slices_gpu(light, std::size_t(settings.hair_light_slices));
+  else
+    light_exact_cpu(light);
+  glDisable(GL_BLEND);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glBindVertexArray(0);
+  check_gl("hair light pass");
+  m_light_done = true;  // line 12: m_light_tex is the light map
+}
+
+void SplatPassGl::light_exact_cpu(const Light& light) {
+  const std::size_t n = m_count;
+  // Line 8's test, for all particles at once: the gather program's objects' visibility (its
+  // hair-light value reads a stale buffer and is not used).
+  glBindFramebuffer(GL_FRAMEBUFFER, m_intensity_fbo);
+  glViewport(0, 0, m_intensity_w, m_intensity_h);
+  glDisable(GL_BLEND);
+  glUseProgram(m_gather_prog);
+  glDrawArrays(GL_POINTS, 0, GLsizei(n));
+  const int w = m_intensity_w;
+  const int rows = int((n + std::size_t(w) - 1) / std::size_t(w));
+  m_staging.assign(2 * std::size_t(w) * std::size_t(rows), 0.0f);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(0, 0, w, rows, GL_RG, GL_FLOAT, m_staging.data());
+  check_gl("hair light pass visibility read-back");
+  for (std::size_t i = 0; i < n; ++i)
+    m_cpu_particles[i].vis = std::clamp(double(m_staging[2 * i]), 0.0, 1.0);
+  if (!m_any_cast)  // nothing is splatted: the buffer stays white, every read is 1
+    for (LightSplatParticle& p : m_cpu_particles) p.casts = false;
+
+  // Lines 6-12, exactly per particle.
+  SplatLightParams prm;
+  prm.light_vp = light.light_vp;
+  prm.travel = light.travel;
+  prm.size = m_light_size;
+  splat_light_pass_bando2003(prm, m_cpu_particles, cpu_hair_texture(), m_cpu_result);
+
+  // The view pass reads (visibility, light through the hair) per particle (line 20), the
+  // meshes the light map (line 16).
+  for (std::size_t i = 0; i < n; ++i) m_staging[2 * i + 1] = m_cpu_result.reach[i];
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glActiveTexture(GL_TEXTURE0 + kUnitIntensity);
+  glBindTexture(GL_TEXTURE_2D, m_intensity_tex);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, rows, GL_RG, GL_FLOAT, m_staging.data());
+  glActiveTexture(GL_TEXTURE0 + kUnitLightBuf);
+  glBindTexture(GL_TEXTURE_2D, m_light_tex);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, m_light_size, m_light_size, GL_RED, GL_FLOAT,
+                  m_cpu_result.light.data());
+}
+
+void SplatPassGl::light_slices_gpu(const Light& light, std::size_t slices_wanted) {
+  const std::size_t n = m_count;
   bind_common(m_light_prog, 0);
   gl::set_mat4(m_light_prog, "uLightVP", light.light_vp);
   gl::set_vec3(m_light_prog, "uLightTravel", light.travel);
@@ -316,18 +396,15 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
               m_items[k].item->splat.shadow_opacity_scale);
 
   // Lines 1 and 6: a white light buffer, no depth test.
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
   glBindFramebuffer(GL_FRAMEBUFFER, m_light_fbo);
   glViewport(0, 0, m_light_size, m_light_size);
   glClearColor(1, 1, 1, 1);
   glClear(GL_COLOR_BUFFER_BIT);
   glBindFramebuffer(GL_FRAMEBUFFER, m_intensity_fbo);
   glClear(GL_COLOR_BUFFER_BIT);
-  glBindVertexArray(empty_vao);
   glBlendFunc(GL_ZERO, GL_ONE_MINUS_SRC_ALPHA);  // light *= (1 - alpha)
 
-  const std::size_t slices = std::min<std::size_t>(n, std::size_t(settings.hair_light_slices));
+  const std::size_t slices = std::min<std::size_t>(n, slices_wanted);
   const std::size_t batch = (n + slices - 1) / slices;
   for (std::size_t b0 = 0; b0 < n; b0 += batch) {
     const std::size_t nb = std::min(batch, n - b0);
@@ -345,12 +422,6 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
     glUseProgram(m_light_prog);
     glDrawArrays(GL_TRIANGLES, GLint(6 * b0), GLsizei(6 * nb));
   }
-  glDisable(GL_BLEND);
-  glEnable(GL_DEPTH_TEST);
-  glDepthMask(GL_TRUE);
-  glBindVertexArray(0);
-  check_gl("hair light pass");
-  m_light_done = true;  // line 12: m_light_tex is the light map
 }
 
 void SplatPassGl::view_pass(const RenderScene& scene, const Mat4& view, const Mat4& view_proj,

@@ -3,11 +3,14 @@
 // renderer_gl.cpp for ParticleItems with ParticleShading::HairSplat). Per render():
 //   prepare()     gathers every HairSplat item into one world-space particle array;
 //   light_pass()  pseudo-code lines 6-12 (the renderer's shadow pass did lines 1-5): particles
-//                 sorted by depth from the light, in slices: read the attenuated light per
-//                 particle on the GPU, then splat the slice into the light buffer, which ends
-//                 as the light map for the meshes;
+//                 sorted by depth from the light each read the attenuated light, then are
+//                 splatted into the light buffer, which ends as the light map for the meshes.
+//                 "cpu" (default): the objects' visibility of all particles in one GL point
+//                 draw read back once, then splat_light_bando2003() exactly per particle on
+//                 the CPU, uploaded as the light map and the per-particle intensities;
+//                 "gpu": in `hair_light_slices` depth slices on the GPU;
 //   view_pass()   lines 17-21: back-to-front textured billboards, Kajiya-Kay x Goldman.
-// See docs/adr/0003-splat-light-pass.md for the slicing.
+// See docs/adr/0005-cpu-splat-light-pass.md and docs/adr/0003-splat-light-pass.md.
 #include <GL/gl.h>
 #include <GL/glext.h>
 
@@ -16,6 +19,7 @@
 #include <vector>
 
 #include "follicle/render/render_scene.hpp"
+#include "follicle/render/splat_light_bando2003.hpp"
 
 namespace follicle::render {
 
@@ -52,6 +56,9 @@ class SplatPassGl {
 
  private:
   GLuint hair_texture();
+  const SplatAlphaTexture& cpu_hair_texture();
+  void light_slices_gpu(const Light& light, std::size_t slices);
+  void light_exact_cpu(const Light& light);
   void ensure_intensity(std::size_t n);
   void ensure_light_buffer(int size);
   void bind_common(GLuint prog, int order_base);
@@ -77,6 +84,13 @@ class SplatPassGl {
   std::weak_ptr<const image::ImageRGBA8> m_custom_owner;
   const void* m_custom_ptr = nullptr;
   int m_max_tbo = 0;
+  // The "cpu" light pass: its particles (the light order and the read-back visibility), the
+  // hair texture's alpha mip chain, the result and the read-back / upload staging.
+  std::vector<LightSplatParticle> m_cpu_particles;
+  std::unique_ptr<SplatAlphaTexture> m_cpu_default_tex, m_cpu_custom_tex;
+  std::shared_ptr<const image::ImageRGBA8> m_cpu_custom_src;
+  SplatLightResult m_cpu_result;
+  std::vector<float> m_staging;
 };
 
 }  // namespace follicle::render

@@ -29,6 +29,9 @@ void Scene::validate(const JsonSource& src) const {
   if (!(camera.near < camera.far))
     json_fail(src, "camera.far",
               fmt::format("far ({}) must be greater than near ({})", camera.far, camera.near));
+  if (render.hair_light_pass != "cpu" && render.hair_light_pass != "gpu")
+    json_fail(src, "render.hair_light_pass",
+              "unknown value \"" + render.hair_light_pass + "\"; expected \"cpu\" or \"gpu\"");
   std::set<std::string> names;
   for (std::size_t i = 0; i < assets.meshes.size(); ++i) {
     const auto& m = assets.meshes[i];

@@ -149,6 +149,7 @@ struct RenderSpec {
   Vec3 background{0.12, 0.12, 0.14};
   Vec3 ambient_color{1, 1, 1};
   int shadow_map_size = 2048;
+  std::string hair_light_pass = "cpu";  // render::RenderSettings::hair_light_pass
 
   template <class V>
   void visit(V&& v) {
@@ -160,6 +161,9 @@ struct RenderSpec {
     v("ambient_color", ambient_color,
       ParamInfo{"linear RGB ambient light (scaled by each material's ambient)", "", 0.0, 10.0});
     v("shadow_map_size", shadow_map_size, ParamInfo{"shadow map resolution", "px", 256, 16384});
+    v("hair_light_pass", hair_light_pass,
+      ParamInfo{"hair splat light pass (Bando 2003 §3.4): \"cpu\" exact per particle, or "
+                "\"gpu\" in depth slices"});
   }
 };
 

@@ -187,6 +187,7 @@ render::RenderSettings Session::render_settings() const {
   s.height = m_scene.render.height;
   s.supersample = m_scene.render.supersample;
   s.shadow_map_size = m_scene.render.shadow_map_size;
+  s.hair_light_pass = m_scene.render.hair_light_pass;
   return s;
 }
 

@@ -183,6 +183,10 @@ TEST(SplatFormulas, BadParametersFail) {
   RenderSettings rs;
   rs.hair_light_slices = 0;
   EXPECT_THROW(rs.validate(), Error);
+  rs = RenderSettings{};
+  EXPECT_EQ(rs.hair_light_pass, "cpu");
+  rs.hair_light_pass = "GPU";
+  EXPECT_THROW(rs.validate(), Error);
   EXPECT_THROW(make_hair_sheet_scene(0), Error);
 }
 
@@ -236,15 +240,18 @@ TEST_F(Splat, SelfShadowDarkensTheFarSideOfASlab) {
 }
 
 TEST_F(Splat, PerParticleReadMatchesTheSlicedLightPass) {
-  // hair_light_slices >= particle count is the paper's per-particle read; the default slicing
-  // must give nearly the same image.
+  // The "gpu" pass: hair_light_slices >= particle count is the paper's per-particle read; the
+  // default slicing must give nearly the same image.
   const int w = 96, h = 96;
   RenderSettings exact = settings(w, h);
+  exact.hair_light_pass = "gpu";
   exact.hair_light_slices = 1 << 20;
+  RenderSettings sliced = settings(w, h);
+  sliced.hair_light_pass = "gpu";
   RenderScene s = slab_scene(true);
   s.particles[0].particles = particle_block(Vec3::Zero(), 1.0, 8);
   const auto a = renderer().render(s, exact);
-  const auto b = renderer().render(s, settings(w, h));
+  const auto b = renderer().render(s, sliced);
   double diff = 0, sum = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
