@@ -20,7 +20,8 @@ namespace {
 int euler_characteristic(const geom::TriMesh& m) {
   std::set<std::pair<int, int>> edges;
   for (const auto& f : m.faces)
-    for (int k = 0; k < 3; ++k) edges.insert({std::min(f[k], f[(k + 1) % 3]), std::max(f[k], f[(k + 1) % 3])});
+    for (int k = 0; k < 3; ++k)
+      edges.insert({std::min(f[k], f[(k + 1) % 3]), std::max(f[k], f[(k + 1) % 3])});
   return int(m.positions.size()) - int(edges.size()) + int(m.faces.size());
 }
 
@@ -58,14 +59,19 @@ TEST(ScalpTrim, FullScalpOfTheHeadReachesTheHairlineAndLeavesTheFace) {
   const auto head = geom::load_mesh(path, LengthUnit::mm);
   // The curves of data/scenes/lcp_*.json: nape, behind and over the ears, front hairline.
   ScalpCurves c;
-  c[0] = {{0.055, 0.03, -0.062}, {0.03, 0.012, -0.068}, {0.0, 0.008, -0.068},
-          {-0.03, 0.012, -0.068}, {-0.055, 0.03, -0.062}};
-  c[1] = {{-0.055, 0.03, -0.062}, {-0.066, 0.08, -0.05}, {-0.068, 0.125, -0.01},
-          {-0.055, 0.145, 0.05}};
-  c[2] = {{-0.055, 0.145, 0.05}, {-0.03, 0.157, 0.07}, {0.0, 0.16, 0.076}, {0.03, 0.157, 0.07},
+  c[0] = {{0.055, 0.03, -0.062},
+          {0.03, 0.012, -0.068},
+          {0.0, 0.008, -0.068},
+          {-0.03, 0.012, -0.068},
+          {-0.055, 0.03, -0.062}};
+  c[1] = {
+      {-0.055, 0.03, -0.062}, {-0.066, 0.08, -0.05}, {-0.068, 0.125, -0.01}, {-0.055, 0.145, 0.05}};
+  c[2] = {{-0.055, 0.145, 0.05},
+          {-0.03, 0.157, 0.07},
+          {0.0, 0.16, 0.076},
+          {0.03, 0.157, 0.07},
           {0.055, 0.145, 0.05}};
-  c[3] = {{0.055, 0.145, 0.05}, {0.068, 0.125, -0.01}, {0.066, 0.08, -0.05},
-          {0.055, 0.03, -0.062}};
+  c[3] = {{0.055, 0.145, 0.05}, {0.068, 0.125, -0.01}, {0.066, 0.08, -0.05}, {0.055, 0.03, -0.062}};
   const Scalp s = Scalp::trim(head, c, ScalpParams{});
   EXPECT_EQ(euler_characteristic(s.mesh()), 1);
   double to_hairline = 1e9, to_crown = 1e9;
