@@ -1,13 +1,7 @@
 #!/usr/bin/env bash
 # follicle bench: --list, one short run printing one JSON object with the required keys, and
 # clean errors for unknown workloads and sizes.
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+source "$(dirname "$0")/lib/common.bash" "$@"
 
 "$FOLLICLE" bench --list >"$TMP/list" 2>"$TMP/err" || { fail "bench --list"; cat "$TMP/err"; }
 cat "$TMP/list"

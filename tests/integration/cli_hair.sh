@@ -3,13 +3,7 @@
 # the same counts; re-export is bit-identical), `follicle animate` writes numbered PNGs and an MP4
 # (when ffmpeg is present), a re-run with the strand cache renders identical frames without
 # simulating, and bad hair keys fail with a JSON path. Uses small copies of the shipped scenes.
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+source "$(dirname "$0")/lib/common.bash" "$@"
 
 # small SCENE OUT [DENSITY] [KEY=JSON ...]: a copy of data/scenes/SCENE.json with absolute asset
 # paths, a low hair density and a small image.

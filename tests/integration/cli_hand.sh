@@ -4,13 +4,7 @@
 # height/normal/displacement maps as EXR + PNG for the rest state and each frame of --frames
 # (sizes checked with `follicle info`-free Python PNG header reads), and clean errors for bad
 # hand keys and for --maps on a scene without a hand. Uses small copies of the shipped scenes.
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+source "$(dirname "$0")/lib/common.bash" "$@"
 
 # small SCENE OUT [FRAMES]: data/scenes/SCENE.json with absolute paths, 128^2 fine maps, a
 # small image and (for animations) FRAMES frames.

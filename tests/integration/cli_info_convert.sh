@@ -1,13 +1,7 @@
 #!/usr/bin/env bash
 # follicle info on a mesh and a scene; follicle convert round trips OBJ -> PLY -> glTF -> OBJ
 # with unit changes and keeps counts and bounds.
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+source "$(dirname "$0")/lib/common.bash" "$@"
 MESH="$ROOT/data/meshes/lee_perry_smith/head.obj"
 
 "$FOLLICLE" info "$MESH" --units mm >"$TMP/info0" 2>"$TMP/err" || { fail "info mesh"; cat "$TMP/err"; }

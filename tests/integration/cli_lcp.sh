@@ -2,13 +2,7 @@
 # LCP particle hair on the CLI: `follicle render` and `follicle animate` (PNGs, MP4 when ffmpeg
 # is present) of short clips of the shipped lcp scenes with few particles; the same frame
 # rendered twice is byte-identical; bad lcp keys fail with a JSON path.
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+source "$(dirname "$0")/lib/common.bash" "$@"
 
 # small SCENE OUT FRAMES: few particles, a small image, FRAMES frames.
 small() {

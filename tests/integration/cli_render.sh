@@ -1,13 +1,7 @@
 #!/usr/bin/env bash
 # follicle render: the default scene renders to a PNG of the requested size; the scene's own
 # outputs are used without -o; failures (broken scene, unwritable output) leave no file behind.
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+source "$(dirname "$0")/lib/common.bash" "$@"
 SCENE="$ROOT/data/scenes/default.json"
 
 png_size() {  # prints "W H" from the IHDR chunk, fails unless the file is a PNG

@@ -4,13 +4,7 @@
 # with and without wrinkles: a positive maximum and an error render of the requested size),
 # `follicle animate` of the contraction track, and clean one-line errors for bad inputs. Uses
 # small copies of the shipped scenes (one refinement level, tiny images).
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
-fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+source "$(dirname "$0")/lib/common.bash" "$@"
 
 # small SCENE OUT [FRAMES FPS]: data/scenes/SCENE.json with absolute paths, one refinement level,
 # a small image and (for animations) FRAMES frames at FPS.

@@ -1,11 +1,6 @@
 #!/usr/bin/env bash
 # Usage errors: exit 2 and exactly one line "follicle: error: ..." on stderr; --help exits 0.
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
+source "$(dirname "$0")/lib/common.bash" "$@"
 check() {  # check NAME EXPECTED_CODE CMD...
   local name=$1 want=$2
   shift 2

@@ -1,12 +1,7 @@
 #!/usr/bin/env bash
 # follicle validate: shipped scenes pass; broken scenes exit 1 with one line naming the file and
 # the JSON path (and a did-you-mean for unknown keys).
-set -u
-FOLLICLE=$(realpath "$1")
-ROOT=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fails=0
+source "$(dirname "$0")/lib/common.bash" "$@"
 MESH="$ROOT/data/meshes/lee_perry_smith/head.obj"
 
 "$FOLLICLE" validate "$ROOT"/data/scenes/*.json >"$TMP/out" 2>"$TMP/err" \

@@ -7,7 +7,7 @@
 
 #include "follicle/render/renderer.hpp"
 #include "follicle/scene/session.hpp"
-#include "hand_lcp_golden.hpp"
+#include "scene_golden.hpp"
 #include "testing/gl_testing.hpp"
 
 using namespace follicle;

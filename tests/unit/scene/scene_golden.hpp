@@ -1,5 +1,6 @@
 #pragma once
-// Golden-image check shared by hand_golden_test.cpp and lcp_golden_test.cpp: compares a render
+// Golden-image check shared by the scene golden tests (default, hair, hand, lcp, skin, face
+// region): compares a render
 // with tests/golden/scene/<name>.png within <name>.tolerance.json; FOLLICLE_UPDATE_GOLDEN=1
 // rewrites the golden instead (look at it after a deliberate change).
 #include <gtest/gtest.h>
