@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
@@ -296,30 +295,38 @@ std::pair<double, double> image_diff(const image::ImageRGBA8& a, const image::Im
 
 }  // namespace
 
-class SplatLightGl : public RenderTest {};
+class SplatLightGl : public RenderTest {
+ protected:
+  /// Renders `s` with the exact GPU pass (one slice per particle) and the CPU pass: the images
+  /// agree closely, and far more closely than with the effect `off` switches off (so the
+  /// comparison measures something).
+  void expect_cpu_matches_exact_gpu(RenderScene s, RenderSettings gpu, const std::string& tag,
+                                    void (*off)(RenderScene&)) {
+    gpu.hair_light_pass = "gpu";
+    gpu.hair_light_slices = 1 << 20;  // >= the particle count: per-particle reads on the GPU
+    RenderSettings cpu = gpu;
+    cpu.hair_light_pass = "cpu";
+    const auto a = renderer().render(s, gpu);
+    const auto b = renderer().render(s, cpu);
+    maybe_save(a, "splat_light_" + tag + "_gpu.png");
+    maybe_save(b, "splat_light_" + tag + "_cpu.png");
+    const auto [rel, worst] = image_diff(a, b);
+    EXPECT_LT(rel, 0.01) << "worst pixel " << worst;
+    EXPECT_LT(worst, 12.0);
+    off(s);
+    const double effect = image_diff(b, renderer().render(s, cpu)).first;
+    EXPECT_GT(effect, 4 * rel) << tag << ": effect " << effect << ", cpu vs gpu " << rel;
+  }
+};
 
 TEST_F(SplatLightGl, CpuPassMatchesTheGpuPassWithOneSlicePerParticle) {
   // The synthetic head with hanging hair: hair self-shadowing and the light map on the head.
   RenderScene s = make_hair_sheet_scene(1200);
   RenderSettings gpu = small_settings(160, 160);
   gpu.hair_light_map_size = 384;
-  gpu.hair_light_pass = "gpu";
-  gpu.hair_light_slices = 1 << 20;  // >= the particle count: per-particle reads on the GPU
-  RenderSettings cpu = gpu;
-  cpu.hair_light_pass = "cpu";
-  const auto a = renderer().render(s, gpu);
-  const auto b = renderer().render(s, cpu);
-  maybe_save(a, "splat_light_gpu_exact.png");
-  maybe_save(b, "splat_light_cpu.png");
-  const auto [rel, worst] = image_diff(a, b);
-  EXPECT_LT(rel, 0.01) << "worst pixel " << worst;
-  EXPECT_LT(worst, 12.0);
   // Self-shadowing is on in both: switching it off changes the image far more than the pass.
-  s.particles[0].splat.self_shadow = false;
-  const double effect = image_diff(b, renderer().render(s, cpu)).first;
-  EXPECT_GT(effect, 4 * rel) << "self-shadow effect " << effect << ", cpu vs gpu " << rel;
-  std::printf("cpu vs gpu (exact): mean %.5f worst %.1f; self-shadow effect %.5f\n", rel, worst,
-              effect);
+  expect_cpu_matches_exact_gpu(s, gpu, "sheet",
+                               [](RenderScene& r) { r.particles[0].splat.self_shadow = false; });
 }
 
 TEST_F(SplatLightGl, CpuPassShadowsTheHeadLikeTheGpuPass) {
@@ -353,23 +360,9 @@ TEST_F(SplatLightGl, CpuPassShadowsTheHeadLikeTheGpuPass) {
   it.radius = 0.06;
   it.opacity = 0.5;
   s.particles.push_back(it);
-  RenderSettings gpu = small_settings(128, 128);
-  gpu.hair_light_pass = "gpu";
-  gpu.hair_light_slices = 1 << 20;
-  RenderSettings cpu = gpu;
-  cpu.hair_light_pass = "cpu";
-  const auto a = renderer().render(s, gpu);
-  const auto b = renderer().render(s, cpu);
-  maybe_save(a, "splat_light_head_gpu.png");
-  maybe_save(b, "splat_light_head_cpu.png");
-  const auto [rel, worst] = image_diff(a, b);
-  EXPECT_LT(rel, 0.01) << "worst pixel " << worst;
-  EXPECT_LT(worst, 12.0);
-  s.particles[0].splat.cast_shadow = false;  // the shadow on the sphere is really there
-  const double effect = image_diff(b, renderer().render(s, cpu)).first;
-  EXPECT_GT(effect, 4 * rel) << "hair shadow effect " << effect << ", cpu vs gpu " << rel;
-  std::printf("cpu vs gpu (exact): mean %.5f worst %.1f; hair shadow effect %.5f\n", rel, worst,
-              effect);
+  // The shadow on the sphere is really there: without casting it the image changes far more.
+  expect_cpu_matches_exact_gpu(s, small_settings(128, 128), "head",
+                               [](RenderScene& r) { r.particles[0].splat.cast_shadow = false; });
 }
 
 TEST_F(SplatLightGl, UnknownLightPassFails) {
