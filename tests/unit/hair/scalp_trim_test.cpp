@@ -1,13 +1,14 @@
 // Scalp trimming (Bando 2003 §3.3.1): the four Catmull-Rom curves cut a disk out of the head
 // mesh. A scalp that reaches the hairline bends further than the loop's plane can see, so faces
 // there turn away from the plane's normal; such islands inside the loop are holes and must be
-// filled, or the harmonic embedding has no disk to map.
+// filled, or the harmonic embedding has no disk to map. Also the hair length map L(u, v).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <set>
 
 #include "follicle/geom/mesh_io.hpp"
+#include "follicle/hair/lcp_bando2003.hpp"
 #include "follicle/hair/scalp_bando2003.hpp"
 #include "lcp_test_scenes.hpp"
 #include "testing/testing.hpp"
@@ -84,4 +85,41 @@ TEST(ScalpTrim, FullScalpOfTheHeadReachesTheHairlineAndLeavesTheFace) {
   EXPECT_LT(to_hairline, 0.012);
   EXPECT_LT(to_crown, 0.012);
   EXPECT_FALSE(face);
+}
+
+TEST(ScalpLengthMap, ShortHairWhereTheMapIsDark) {
+  // §3.3.1: L(u, v) = max_length * map(u, v). Left half of the map 0.25, right half 1: the
+  // particles of the pillar (u, v, s) stop at s <= L(u, v) on each side.
+  const auto head = test::lcp_sphere(0.1, 24, 48);
+  ScalpParams sp;
+  sp.max_length = 0.12;
+  sp.root_depth = 0.01;
+  Scalp scalp = Scalp::trim(head, test::lcp_cap_curves(0.1, 1.1), sp);
+  image::ImageF map(16, 16, 1.0f);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 8; ++x) map.at(x, y) = 0.25f;
+  scalp.set_length_map(map);
+  EXPECT_NEAR(scalp.length(Vec2(0.1, 0.5)), 0.25 * 0.12, 1e-9);
+  EXPECT_NEAR(scalp.length(Vec2(0.9, 0.3)), 0.12, 1e-9);
+  Context ctx(1, 5);
+  LcpInitParams ip;
+  ip.spacing = 0.012;
+  ip.whirl_point = Vec3(0, 0.1, 0.02);
+  const LcpInit init = initialize_lcp(ctx, scalp, ip);
+  double left_max = 0, right_max = 0;
+  int left = 0, right = 0;
+  for (const Vec3& q : init.model.uvs) {
+    if (q.x() < 0.4) {
+      left_max = std::max(left_max, q.z());
+      ++left;
+    } else if (q.x() > 0.6) {
+      right_max = std::max(right_max, q.z());
+      ++right;
+    }
+  }
+  ASSERT_GT(left, 10);
+  ASSERT_GT(right, 10);
+  EXPECT_LE(left_max, 0.25 * 0.12 + 1e-9);
+  EXPECT_GT(right_max, 0.6 * 0.12);
+  EXPECT_GT(right, 2 * left);  // longer hair, more particles per unit of scalp
 }
