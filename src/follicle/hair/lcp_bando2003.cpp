@@ -421,13 +421,17 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
 // particle owns: its own state, the connections of which it is the tip-side end (each connection
 // has exactly one), and the hair-hair pairs of its sorted neighbour list with a higher index. Per-
 // pair and per-connection values are then gathered in a fixed order, so results do not depend on
-// the thread count. Six parallel loops per sub-step:
-//   1. k_ij (3.7) + tethers, W(h, r) per pair, largest displacement since the list build
+// the thread count. Five parallel loops per sub-step:
+//   1. k_ij (3.7) + tethers, W(h, r) per pair and the compact list of interacting pairs,
+//      largest displacement since the list build
 //   2. alpha sums (3.13), density (3.1) and pressure
 //   3. alpha_ij (3.14), spring forces, hair-hair forces (3.16)-(3.18)
 //   4. gather of the forces, accelerations and the leapfrog update
-//   5. connection geometry at the new positions (shared by both ends and the next sub-step)
-//   6. direction update (3.15) and the blow-up check
+//   5. connection geometry at the new positions (stored by the tip-side end for the next
+//      sub-step, recomputed bit-identically by the root-side end), direction update (3.15)
+//      and the blow-up check
+// Each particle's connections are kept in two lists by its role (root-side / tip-side end), so
+// none of these loops branches per connection on which end it is.
 
 namespace {
 constexpr std::size_t kChunk = 256;  // particles per task of the fused loops
@@ -454,6 +458,7 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
     if (m_model.adj_pairs[e] >= np)
       fail_at(fmt::format("lcp.adjacency[{}]", e), "connection index out of range");
   m_rho0 = m_params.rho0_scale * m_model.rest_density;
+  m_ks = SphKernel(m_model.h_s);
   m_sin_a.resize(m_model.num_pairs());
   m_sin_b.resize(m_model.num_pairs());
   for (std::size_t q = 0; q < m_model.num_pairs(); ++q) {
@@ -462,20 +467,35 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
   }
   m_ea.resize(n);
   for (std::size_t i = 0; i < n; ++i) m_ea[i] = m_params.elastic_modulus * cross_section(i);
-  // Root-side connections of each particle (those with pair_b == i), in adjacency order.
-  m_rs_offsets.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    uint32_t c = 0;
-    for (uint32_t e = m_model.adj_offsets[i]; e < m_model.adj_offsets[i + 1]; ++e)
-      if (m_model.pair_b[m_model.adj_pairs[e]] == i) ++c;
-    m_rs_offsets[i + 1] = m_rs_offsets[i] + c;
+  // Connections of each particle by its role (pair_b == i: root-side partner; pair_a == i:
+  // tip-side partner), in adjacency order.
+  auto split = [&](bool as_b, std::vector<uint32_t>& off, std::vector<uint32_t>& pairs,
+                   std::vector<double>& cs, std::vector<double>& sn) {
+    off.assign(n + 1, 0);
+    pairs.clear();
+    cs.clear();
+    sn.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      for (uint32_t e = m_model.adj_offsets[i]; e < m_model.adj_offsets[i + 1]; ++e) {
+        const uint32_t q = m_model.adj_pairs[e];
+        if ((as_b ? m_model.pair_b[q] : m_model.pair_a[q]) != i) continue;
+        pairs.push_back(q);
+        // cos theta0_ij against x_ij = x_j - x_i: +cos_a at the root-side end, -cos_b at the
+        // tip-side end (x_ij = -x_ab there).
+        cs.push_back(as_b ? -m_model.cos_b[q] : m_model.cos_a[q]);
+        sn.push_back(as_b ? m_sin_b[q] : m_sin_a[q]);
+      }
+      off[i + 1] = uint32_t(pairs.size());
+    }
+  };
+  split(true, m_rs_offsets, m_rs_pairs, m_rs_cos, m_rs_sin);
+  split(false, m_ts_offsets, m_ts_pairs, m_ts_cos, m_ts_sin);
+  m_damp.resize(np);
+  for (std::size_t q = 0; q < np; ++q) {
+    const double ma = m_model.mass[m_model.pair_a[q]], mb = m_model.mass[m_model.pair_b[q]];
+    m_damp[q] = 2.0 * m_params.spring_damping * std::sqrt(ma * mb / (ma + mb));
   }
-  m_rs_pairs.clear();
-  m_rs_pairs.reserve(m_rs_offsets[n]);
-  for (std::size_t i = 0; i < n; ++i)
-    for (uint32_t e = m_model.adj_offsets[i]; e < m_model.adj_offsets[i + 1]; ++e)
-      if (m_model.pair_b[m_model.adj_pairs[e]] == i) m_rs_pairs.push_back(m_model.adj_pairs[e]);
-  if (m_rs_pairs.size() != np)
+  if (m_rs_pairs.size() != np || m_ts_pairs.size() != np)
     fail_at("lcp", "every connection must appear once in the adjacency of each of its ends");
 }
 
@@ -498,7 +518,7 @@ void LcpSolver::coefficients_of(std::size_t i, const LcpState& s, LcpWorkspace& 
   const uint32_t r0 = m_rs_offsets[i], r1 = m_rs_offsets[i + 1];
   for (uint32_t e = r0; e < r1; ++e) {
     const uint32_t q = m_rs_pairs[e];
-    ws.k[q] = m.c[q] * sph_w(m.h_s, r_of(q));  // (3.7) k_ij = c_ij W(h_s, |x_ij|)
+    ws.k[q] = m.c[q] * m_ks.w(r_of(q));  // (3.7) k_ij = c_ij W(h_s, |x_ij|)
   }
   // A particle whose root-side springs have all drawn apart beyond 2 h_s would be free and fall
   // off the head. Its nearest root-side spring is kept at the coefficient it has at r = 2 h_s
@@ -516,18 +536,19 @@ void LcpSolver::coefficients_of(std::size_t i, const LcpState& s, LcpWorkspace& 
       best = q;
     }
   }
-  if (best != uint32_t(-1)) ws.k[best] = m.c[best] * sph_w(m.h_s, kTetherFraction * 2 * m.h_s);
+  if (best != uint32_t(-1)) ws.k[best] = m.c[best] * m_ks.w(kTetherFraction * 2 * m.h_s);
 }
 
 void LcpSolver::alpha_sums_of(std::size_t i, LcpWorkspace& ws) const {
   const auto& m = m_model;
   double sr = 0, st = 0;
-  for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
-    const uint32_t q = m.adj_pairs[e];
-    if (m.pair_b[q] == i)
-      sr += m.l0[q] * ws.k[q];  // the other end is in N_r(i)
-    else
-      st += m.l0[q] * ws.k[q];  // the other end is in N_t(i)
+  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
+    const uint32_t q = m_rs_pairs[e];
+    sr += m.l0[q] * ws.k[q];  // the other end is in N_r(i)
+  }
+  for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e) {
+    const uint32_t q = m_ts_pairs[e];
+    st += m.l0[q] * ws.k[q];  // the other end is in N_t(i)
   }
   const double ea = m_ea[i];
   ws.alpha_r[i] = sr > 0 ? ea / sr : 0.0;  // (3.13)
@@ -632,13 +653,21 @@ void upper_starts(const Context& ctx, const std::vector<uint32_t>& off,
 }
 }  // namespace
 
+void LcpSolver::pair_scratch(LcpWorkspace& ws) {
+  const std::size_t ne = ws.nbrs.size();
+  ws.pair_w.resize(ne);
+  ws.pair_f.resize(ne);
+  ws.pair_act.resize(ne);
+  ws.act_end.resize(ws.nbr_offsets.empty() ? 0 : ws.nbr_offsets.size() - 1);
+}
+
 void LcpSolver::density_of(std::size_t i, LcpWorkspace& ws, double w0) const {
   const auto& m = m_model;
   double rho = m.mass[i] * w0;
-  for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-    const uint32_t j = ws.nbrs[e];
-    rho += m.mass[j] * ws.pair_w[j > i ? e : ws.nbr_mirror[e]];  // (3.1)
-  }
+  // (3.1), in list order: pairs below nbr_upper[i] were evaluated by the other end.
+  const uint32_t e0 = ws.nbr_offsets[i], eu = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
+  for (uint32_t e = e0; e < eu; ++e) rho += m.mass[ws.nbrs[e]] * ws.pair_w[ws.nbr_mirror[e]];
+  for (uint32_t e = eu; e < e1; ++e) rho += m.mass[ws.nbrs[e]] * ws.pair_w[e];
   ws.density[i] = rho;
   ws.pressure[i] = m_params.k_a * (rho - m_rho0);  // P = k_a (rho - rho0)
   ws.p_rho2[i] = ws.pressure[i] / (rho * rho);
@@ -668,30 +697,47 @@ void LcpSolver::spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, do
   const double ext = r - m.l0[q];
   // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
   const double kk = ext < 0 ? ak * p.compression_scale : ak;
-  const double mu = m.mass[a] * m.mass[b] / (m.mass[a] + m.mass[b]);
-  const double cd = 2.0 * p.spring_damping * std::sqrt(kk * mu);
+  const double cd = m_damp[q] * std::sqrt(kk);  // 2 zeta sqrt(k mu), critical damping ratio zeta
   ws.spring_f[q] = (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
+}
+
+void LcpSolver::active_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
+                                const SphKernel& K) const {
+  // W(h, r) of every pair i < j of the list (0 beyond 2h) and the compact list of the pairs that
+  // interact (0 < r < 2h), stored from nbr_upper[i] on; pair_f of the others is zeroed. Without
+  // branches on the distance: with the Verlet skin about a third of the listed pairs lie beyond
+  // 2h, in no predictable order.
+  const double r2max = 4 * m_model.h * m_model.h;
+  const Vec3 xi = s.x[i];
+  const uint32_t e0 = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
+  uint32_t k = e0;
+  for (uint32_t e = e0; e < e1; ++e) {
+    const double d2 = (s.x[ws.nbrs[e]] - xi).squaredNorm();
+    const double w = K.w(std::sqrt(d2));
+    const bool inside = d2 < r2max;
+    ws.pair_w[e] = inside ? w : 0.0;
+    ws.pair_f[e] = Vec3::Zero();
+    ws.pair_act[k] = e;
+    k += (inside && d2 > 0) ? 1u : 0u;
+  }
+  ws.act_end[i] = k;
 }
 
 void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
                               const SphKernel& K, double inv_w0) const {
-  // Hair-hair force (3.16)-(3.18) on i from j, once per pair (i < j); j gets the negation.
+  // Hair-hair force (3.16)-(3.18) on i from j, once per interacting pair (i < j, listed by
+  // active_pairs_of); j gets the negation.
   const auto& m = m_model;
   const auto& p = m_params;
-  const double h = m.h, r2max = 4 * h * h;
   const double eps2 = p.colinear_eps * p.colinear_eps;
   const Vec3 xi = s.x[i], vi = s.v[i], ti = s.t[i];
   const double mi = m.mass[i], pi = ws.p_rho2[i];
-  for (uint32_t e = ws.nbr_upper[i]; e < ws.nbr_offsets[i + 1]; ++e) {
+  for (uint32_t k = ws.nbr_upper[i]; k < ws.act_end[i]; ++k) {
+    const uint32_t e = ws.pair_act[k];
     const uint32_t j = ws.nbrs[e];
     const Vec3 xab = s.x[j] - xi;
-    const double r2 = xab.squaredNorm();
-    if (!(r2 < r2max) || !(r2 > 0)) {
-      ws.pair_f[e] = Vec3::Zero();
-      continue;
-    }
-    const double r = std::sqrt(r2);
-    const Vec3 xh = xab / r;
+    const double r = std::sqrt(xab.squaredNorm());
+    const Vec3 xh = xab * (1.0 / r);
     double w, dw;
     K.w_dw(r, w, dw);
     const double mj = m.mass[j];
@@ -702,20 +748,24 @@ void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws
     // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is
     // t_i, i.e. ALONG the hair, contradicting "normal to the hair directions". We use the
     // part of x^_ij normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which the case needs.
-    Vec3 dn = ti.cross(s.t[j]);
-    double dn2 = dn.squaredNorm();
-    if (dn2 < eps2) {
-      dn = xh - xh.dot(ti) * ti;
-      dn2 = dn.squaredNorm();
-    }
+    // Both are computed and one selected: neighbouring hairs are often near-colinear.
+    const Vec3 dc = ti.cross(s.t[j]);
+    const Vec3 dp = xh - xh.dot(ti) * ti;
+    const double dc2 = dc.squaredNorm(), dp2 = dp.squaredNorm();
+    const bool colinear = dc2 < eps2;
+    const double dn2 = colinear ? dp2 : dc2;
+    const Vec3 dn(colinear ? dp.x() : dc.x(), colinear ? dp.y() : dc.y(),
+                  colinear ? dp.z() : dc.z());
     if (dn2 >= 1e-18) {
-      const Vec3 dh = dn / std::sqrt(dn2);
+      const Vec3 dh = dn * (1.0 / std::sqrt(dn2));
       const Vec3 vab = s.v[j] - vi;
       // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one
       // setting works for any particle count: d_c(paper) = d_c mu / W(h, 0).
       const double muw = mi * mj / (mi + mj) * (w * inv_w0);
       const double vn = vab.dot(dh);
-      if (vn * xab.dot(dh) < 0) f += p.collision_damping * muw * vn * dh;  // (3.17)
+      // (3.17) only while the pair approaches along d_n
+      const double dc_on = vn * xab.dot(dh) < 0 ? p.collision_damping : 0.0;
+      f += dc_on * muw * vn * dh;
       f += p.friction_damping * muw * (vab - vn * dh);  // (3.18) d_f W (v_ij . d^_t) d^_t
     }
     ws.pair_f[e] = f;
@@ -723,24 +773,17 @@ void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws
 }
 
 Vec3 LcpSolver::gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const {
-  // Gather in a fixed order (adjacency, then neighbour list): deterministic for any thread
-  // count, and each pair's two contributions are exact negations.
-  const auto& m = m_model;
+  // Gather in a fixed order (connections by role, then the neighbour list): deterministic for
+  // any thread count, and each pair's two contributions are exact negations.
   Vec3 f = Vec3::Zero();
-  for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
-    const uint32_t q = m.adj_pairs[e];
-    if (m.pair_a[q] == i)
-      f += ws.spring_f[q];
-    else
-      f -= ws.spring_f[q];
+  for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e) f += ws.spring_f[m_ts_pairs[e]];
+  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) f -= ws.spring_f[m_rs_pairs[e]];
+  if (hh) {
+    // The lists are sorted: entries below nbr_upper[i] are pairs evaluated by the other end.
+    const uint32_t e0 = ws.nbr_offsets[i], eu = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
+    for (uint32_t e = e0; e < eu; ++e) f -= ws.pair_f[ws.nbr_mirror[e]];
+    for (uint32_t e = eu; e < e1; ++e) f += ws.pair_f[e];
   }
-  if (hh)
-    for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-      if (ws.nbrs[e] > i)
-        f += ws.pair_f[e];
-      else
-        f -= ws.pair_f[ws.nbr_mirror[e]];
-    }
   return f;
 }
 
@@ -762,45 +805,69 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
     ws.p_rho2.resize(n);
     for (std::size_t i = 0; i < n; ++i)
       ws.p_rho2[i] = ws.pressure[i] / (ws.density[i] * ws.density[i]);
-    ws.pair_f.resize(ws.nbrs.size());
+    pair_scratch(ws);
     const SphKernel K(m.h);
     const double inv_w0 = 1.0 / K.w(0.0);
-    parallel_for(ctx, 0, n, [&](std::size_t i) { hair_pairs_of(i, s, ws, K, inv_w0); });
+    parallel_for(ctx, 0, n, [&](std::size_t i) {
+      active_pairs_of(i, s, ws, K);
+      hair_pairs_of(i, s, ws, K, inv_w0);
+    });
   }
   parallel_for(ctx, 0, n, [&](std::size_t i) { ws.force[i] = gather_of(i, ws, hh); });
 }
 
+void LcpSolver::geometry_of(std::size_t i, const LcpState& s, LcpWorkspace& ws) const {
+  // |x_ab| and x^_ab of the connections of which i is the tip-side end b.
+  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
+    const uint32_t q = m_rs_pairs[e];
+    const Vec3 d = s.x[i] - s.x[m_model.pair_a[q]];  // x_ab, b = i
+    const double r = d.norm();
+    ws.conn_r[q] = r;
+    ws.conn_xh[q] = d * (1.0 / r);
+  }
+}
+
 void LcpSolver::direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws,
-                             bool cached) const {
+                             bool cached_rs) const {
   const auto& m = m_model;
   if (m.root[i]) return;
-  Vec3 acc = Vec3::Zero();
   const Vec3 ti = s.t[i];
-  for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e) {
-    const uint32_t q = m.adj_pairs[e];
-    const bool is_a = m.pair_a[q] == i;
+  // (3.15) t_i = sum_j alpha_ij k_ij t_i^j / |.|, with t_i^j the unit vector at angle theta0_ij
+  // from x^_ij in the plane of t_i and x_ij (Fig. 3.3 c):
+  //   t_i^j = cos0 x^ + sin0 (t_i - (t_i . x^) x^) / |t_i - (t_i . x^) x^|.
+  // Summed as acc = sum_j [a_j x^_j] + b t_i with scalar a_j = ak (cos0 - sin0 (t_i . x^) / p_j)
+  // and b = sum_j ak sin0 / p_j (p_j = |t_i - (t_i . x^) x^|; the sin0 part drops when p_j
+  // vanishes, x^ parallel to t_i). sign = +1 where i is the root-side end a (x_ij = x_ab),
+  // -1 where it is the tip-side end b.
+  Vec3 acc = Vec3::Zero();
+  double bsum = 0;
+  // The geometry of a connection is either read from ws.conn_r / conn_xh (filled by
+  // geometry_of at the tip-side end) or computed here by the same expression, so both ends see
+  // it bit for bit (x_ji = -x_ij exactly).
+  auto add = [&](uint32_t q, double sign, double c0, double s0, bool cached) {
     double r;
     Vec3 xh;  // x^_ij
     if (cached) {
-      // x_ji = -x_ij exactly, so the shared geometry serves both ends bit for bit.
       r = ws.conn_r[q];
-      if (r <= 0) continue;
-      xh = is_a ? ws.conn_xh[q] : Vec3(-ws.conn_xh[q]);
+      xh = sign * ws.conn_xh[q];
     } else {
-      const uint32_t j = is_a ? m.pair_b[q] : m.pair_a[q];
-      const Vec3 d = s.x[j] - s.x[i];
+      const Vec3 d = s.x[m.pair_b[q]] - s.x[m.pair_a[q]];
       r = d.norm();
-      if (r <= 0) continue;
-      xh = d / r;
+      xh = sign * (d * (1.0 / r));
     }
-    const double c0 = is_a ? m.cos_a[q] : -m.cos_b[q];  // cos theta0_ij against x_ij
-    const double s0 = is_a ? m_sin_a[q] : m_sin_b[q];   // sin theta0_ij
-    Vec3 perp = ti - ti.dot(xh) * xh;
-    const double pn = perp.norm();
-    // t_i^j: x^_ij rotated by theta0_ij about the axis normal to t_i and x_ij (Fig. 3.3 c).
-    const Vec3 tij = pn > 1e-12 ? Vec3(c0 * xh + s0 * perp / pn) : Vec3(c0 * xh);
-    acc += ws.alpha[q] * ws.k[q] * tij;  // (3.15)
-  }
+    if (!(r > 0)) return;
+    const double ak = ws.alpha[q] * ws.k[q];
+    const double d = ti.dot(xh);
+    const double pn = (ti - d * xh).norm();
+    const double sp = pn > 1e-12 ? ak * s0 / pn : 0.0;
+    acc += (ak * c0 - sp * d) * xh;
+    bsum += sp;
+  };
+  for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e)
+    add(m_ts_pairs[e], 1.0, m_ts_cos[e], m_ts_sin[e], false);
+  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e)
+    add(m_rs_pairs[e], -1.0, m_rs_cos[e], m_rs_sin[e], cached_rs);
+  acc += bsum * ti;
   const double an = acc.norm();
   if (an > 1e-300 && std::isfinite(an)) s.t[i] = acc / an;
 }
@@ -846,15 +913,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.conn_r.resize(np);
   ws.conn_xh.resize(np);
   ws.geom_owner = nullptr;  // set again below once it matches s.x
-  auto geometry_of = [&](std::size_t i) {
-    for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
-      const uint32_t q = m_rs_pairs[e];
-      const Vec3 d = s.x[i] - s.x[m.pair_a[q]];  // x_ab, b = i
-      const double r = d.norm();
-      ws.conn_r[q] = r;
-      ws.conn_xh[q] = d / r;
-    }
-  };
+  auto geometry_of = [&](std::size_t i) { this->geometry_of(i, s, ws); };
   if (!geom_valid) parallel_for(ctx, 0, n, geometry_of);
   // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
   // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
@@ -896,7 +955,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   const std::size_t nchunks = (n + kChunk - 1) / kChunk;
   ws.chunk_max.resize(nchunks);
   ws.chunk_check.resize(nchunks);
-  const double h = m.h, r2max = 4 * h * h;
+  const double h = m.h;
   const SphKernel K(h);
   const double w0 = K.w(0.0), inv_w0 = 1.0 / w0;
   const double skin = P.neighbour_skin * 2 * h;
@@ -917,8 +976,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       if (rebuild) rebuild_neighbours(ctx, s, ws);
       if (rebuild || ws.nbr_upper.size() != n)
         upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
-      ws.pair_w.resize(ws.nbrs.size());
-      ws.pair_f.resize(ws.nbrs.size());
+      pair_scratch(ws);
     }
     for (int attempt = 0; attempt < 2; ++attempt) {
       parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
@@ -926,12 +984,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
         for (std::size_t i = i0; i < i1; ++i) {
           if (do_alpha) coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
           if (!hh) continue;
-          const Vec3 xi = s.x[i];
-          dmax = std::max(dmax, (xi - ws.nbr_built_x[i]).squaredNorm());
-          for (uint32_t e = ws.nbr_upper[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-            const double d2 = (s.x[ws.nbrs[e]] - xi).squaredNorm();
-            ws.pair_w[e] = d2 < r2max ? K.w(std::sqrt(d2)) : 0.0;
-          }
+          dmax = std::max(dmax, (s.x[i] - ws.nbr_built_x[i]).squaredNorm());
+          active_pairs_of(i, s, ws, K);
         }
         ws.chunk_max[i0 / kChunk] = dmax;
       });
@@ -944,8 +998,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       rebuild = true;
       rebuild_neighbours(ctx, s, ws);
       upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
-      ws.pair_w.resize(ws.nbrs.size());
-      ws.pair_f.resize(ws.nbrs.size());
+      pair_scratch(ws);
     }
     // 2. alpha sums (3.13), density (3.1) and pressure.
     parallel_for(ctx, 0, n, [&](std::size_t i) {
@@ -1004,14 +1057,14 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       s.v[i] += a * dt;
       s.x[i] += s.v[i] * dt;
     });
-    // 5. Connection geometry at the new positions.
-    parallel_for(ctx, 0, n, geometry_of);
-    // 6. Directions (3.15) and the blow-up check: first non-finite or too fast particle, in
-    // index order.
+    // 5. Connection geometry at the new positions (of the connections of which i is the
+    // tip-side end; the others are recomputed identically), directions (3.15) and the blow-up
+    // check: first non-finite or too fast particle, in index order.
     const double vlim = P.max_speed;
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
       LcpWorkspace::ChunkCheck c;
       for (std::size_t i = i0; i < i1; ++i) {
+        this->geometry_of(i, s, ws);
         direction_of(i, s, ws, true);
         const double sp = s.v[i].norm();
         const bool bad =

@@ -179,10 +179,12 @@ struct LcpWorkspace {
   std::size_t nbr_builds = 0;        // number of list builds (statistics)
   std::vector<double> pair_w;        // W(h, r) per entry with i < j
   std::vector<Vec3> pair_f;          // hair-hair force on i per entry with i < j [N]
-  std::vector<Vec3> spring_f;        // spring force on the root-side end per connection [N]
-  std::vector<double> p_rho2;        // P_i / rho_i^2 per particle
-  std::vector<uint8_t> contact;      // per particle, last sub-step
-  std::vector<double> penetration;   // per particle, last sub-step [m]
+  // Entries (i < j) with 0 < r < 2h, compacted per particle into [nbr_upper[i], act_end[i]).
+  std::vector<uint32_t> pair_act, act_end;
+  std::vector<Vec3> spring_f;       // spring force on the root-side end per connection [N]
+  std::vector<double> p_rho2;       // P_i / rho_i^2 per particle
+  std::vector<uint8_t> contact;     // per particle, last sub-step
+  std::vector<double> penetration;  // per particle, last sub-step [m]
   // First entry of each neighbour list with a higher index (the lists are sorted): the pairs a
   // particle evaluates itself.
   std::vector<uint32_t> nbr_upper;
@@ -270,18 +272,29 @@ class LcpSolver {
   void alpha_sweeps(const Context& ctx, LcpWorkspace& ws) const;
   void spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, double r,
                  const Vec3& xh) const;
+  void active_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
+                       const SphKernel& K) const;
+  static void pair_scratch(LcpWorkspace& ws);
   void hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws, const SphKernel& K,
                      double inv_w0) const;
   Vec3 gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const;
-  void direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws, bool cached) const;
+  void geometry_of(std::size_t i, const LcpState& s, LcpWorkspace& ws) const;
+  void direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws, bool cached_rs) const;
   void density_of(std::size_t i, LcpWorkspace& ws, double w0) const;
-  std::vector<uint32_t> m_rs_offsets, m_rs_pairs;  // tip-side particle -> its root-side connections
+  // Each particle's connections split by its role, in adjacency order, so the per-particle loops
+  // run without a data-dependent branch per connection: m_rs_* lists the connections of which
+  // the particle is the tip-side end b (its partner is in N_r), m_ts_* those of which it is the
+  // root-side end a (partner in N_t). Per entry, cos/sin theta0 of the particle's own end.
+  std::vector<uint32_t> m_rs_offsets, m_rs_pairs, m_ts_offsets, m_ts_pairs;
+  std::vector<double> m_rs_cos, m_rs_sin, m_ts_cos, m_ts_sin;
+  std::vector<double> m_damp;  // 2 zeta sqrt(mu_ab) per connection (spring damping factor)
   LcpParams m_params;
   std::vector<double> m_ea;              // E A_i per particle ((3.9) with the constant modulus)
   std::vector<double> m_sin_a, m_sin_b;  // sin theta0 per connection end (for (3.15))
   LcpModel m_model;
   const sim::VoxelPlanes* m_body = nullptr;
   double m_rho0 = 0;
+  SphKernel m_ks{1.0};  // Monaghan's kernel with the connection smoothing length h_s
 };
 
 /// World positions (and optionally velocities, directions) of the particles for a head sample.

@@ -95,8 +95,10 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     return rep;
   }
   if (force_on_hair) force_on_hair->resize(nh);
-  const double rc = m_p.coupling_radius, wc0 = sph_w(rc / 2, 0.0);
+  const double rc = m_p.coupling_radius;
   const double h = m_h, cs = std::sqrt(m_p.k_p);
+  const SphKernel K(h), Kc(rc / 2);  // air-air; air-hair coupling (zero beyond rc)
+  const double inv_wc0 = 1.0 / Kc.w(0.0);
   std::vector<Vec3>& impulse = m_impulse;
   impulse.resize(nh);
   parallel_for(
@@ -118,16 +120,16 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     m_rho.resize(n);
     m_pr.resize(n);
     parallel_for(ctx, 0, n, [&](std::size_t i) {
-      double rho = m_mass * sph_w(h, 0.0);
+      double rho = m_mass * K.w(0.0);
       for (uint32_t e = m_off[i]; e < m_off[i + 1]; ++e)
-        rho += m_mass * sph_w(h, (m_x[m_nb[e]] - m_x[i]).norm());  // (3.1)
+        rho += m_mass * K.w((m_x[m_nb[e]] - m_x[i]).norm());  // (3.1)
       m_rho[i] = rho;
       m_pr[i] = m_p.k_p * std::max(rho - m_rho0, 0.0);
     });
     auto drag_on_hair = [&](std::size_t hi, std::size_t ai) -> Vec3 {
       const double r = (m_x[ai] - hair_x[hi]).norm();
       const double mu = hair_mass[hi] * m_mass / (hair_mass[hi] + m_mass);
-      return m_p.drag * mu * (sph_w(rc / 2, r) / wc0) * (m_v[ai] - hair_v[hi]);
+      return m_p.drag * mu * (Kc.w(r) * inv_wc0) * (m_v[ai] - hair_v[hi]);
     };
     // Air-hair pairs: lists from each air particle to the hair within rc; the drag of each pair
     // is evaluated once (force on the hair particle, the air particle gets the negation) and
@@ -156,8 +158,10 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
         const Vec3 d = m_x[j] - m_x[i];
         const double r = d.norm();
         if (r <= 0) continue;
+        double w, dw;
+        K.w_dw(r, w, dw);
         // (3.16) -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) grad_i W, grad_i W = -W'(r) d/r
-        f += m_mass * m_mass * (pi + m_pr[j] / (m_rho[j] * m_rho[j])) * sph_dw(h, r) * d / r;
+        f += (m_mass * m_mass * (pi + m_pr[j] / (m_rho[j] * m_rho[j])) * dw / r) * d;
       }
       if (nh)
         for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) f -= m_drag[e];

@@ -28,6 +28,26 @@ TEST(LcpKernel, IntegratesToOne) {
   }
 }
 
+TEST(LcpKernel, BranchFreeKernelEqualsThePiecewiseForm) {
+  // SphKernel evaluates W and dW/dr as a difference of truncated cubics; it must equal
+  // Monaghan's piecewise polynomials on both pieces, at the joints and beyond 2h.
+  const double h = 0.0075;
+  const SphKernel K(h);
+  for (int i = 0; i <= 500; ++i) {
+    const double r = 2.5 * h * i / 500;
+    double w, dw;
+    K.w_dw(r, w, dw);
+    const double scale_w = sph_w(h, 0), scale_dw = std::abs(sph_dw(h, h));
+    EXPECT_NEAR(w, sph_w(h, r), 1e-13 * scale_w) << "r = " << r;
+    EXPECT_NEAR(K.w(r), w, 0.0) << "r = " << r;
+    EXPECT_NEAR(dw, sph_dw(h, r), 1e-13 * scale_dw) << "r = " << r;
+    if (r >= 2 * h) {
+      EXPECT_EQ(w, 0.0);
+      EXPECT_EQ(dw, 0.0);
+    }
+  }
+}
+
 TEST(LcpDensity, RegularLatticeMatchesAnalyticValue) {
   // (3.1) on a cubic lattice: the density of an interior particle is the lattice sum
   // m sum_n W(h, a|n|), which for h = a is within 1 % of the continuum value m / a^3.
