@@ -167,10 +167,19 @@ void LcpScenario::world(std::vector<Vec3>& x, std::vector<Vec3>* t) const {
   lcp_world(m_state, head_pose(), &x, nullptr, t);
 }
 
-LcpStepReport LcpScenario::step(const Context& ctx, double dt) {
+LcpStepReport LcpScenario::step(const Context& ctx, double dt,
+                                const std::vector<Vec3>* extra_force) {
   LcpStepInput in;
   in.dt = dt;
   in.head = head_pose();
+  const std::size_t n = m_state.x.size();
+  if (extra_force && extra_force->size() != n) {
+    LcpStepReport r;
+    r.ok = false;
+    r.message = fmt::format("lcp: {} extra forces for {} particles", extra_force->size(), n);
+    return r;
+  }
+  in.external_force = extra_force;
   if (m_air) {
     lcp_world(m_state, in.head, &m_wx, &m_wv);
     const sim::StepReport ar =
@@ -180,6 +189,8 @@ LcpStepReport LcpScenario::step(const Context& ctx, double dt) {
       static_cast<sim::StepReport&>(r) = ar;
       return r;
     }
+    if (extra_force)
+      for (std::size_t i = 0; i < n; ++i) m_wind_force[i] += (*extra_force)[i];
     in.external_force = &m_wind_force;
   }
   return m_solver->step(ctx, in, m_state, m_ws);

@@ -123,8 +123,9 @@ class LcpScenario {
   LcpScenario(const Context& ctx, const LcpScenarioParams& params, const LcpParams& lcp = {},
               const geom::TriMesh* head_mesh = nullptr, const image::ImageF* length_map = nullptr);
 
-  /// One frame of dt: wind (if any) first, then the hair with the wind's drag as external force.
-  LcpStepReport step(const Context& ctx, double dt);
+  /// One frame of dt: wind (if any) first, then the hair with the wind's drag as external force,
+  /// plus `extra_force` [N, world frame, one per particle] when given (e.g. a parting force).
+  LcpStepReport step(const Context& ctx, double dt, const std::vector<Vec3>* extra_force = nullptr);
 
   double time() const { return m_state.time; }
   const LcpSolver& solver() const { return *m_solver; }

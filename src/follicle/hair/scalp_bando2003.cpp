@@ -33,7 +33,7 @@ Vec2 square_point(int curve, double t) {
   }
 }
 
-/// Edge-connected components of the faces with member[f] != 0 (id -1 for the others).
+/// Component id per face (-1 outside the face set) and face count per component.
 struct FaceComponents {
   std::vector<int> id;
   std::vector<int> size;
@@ -42,16 +42,23 @@ struct FaceComponents {
   }
 };
 
-FaceComponents face_components(const geom::TriMesh& m, const std::vector<char>& member) {
-  const std::size_t nf = m.faces.size();
-  std::map<std::pair<int, int>, std::vector<uint32_t>> edge_faces;
-  for (std::size_t f = 0; f < nf; ++f) {
-    if (!member[f]) continue;
+using EdgeFaces = std::map<std::pair<int, int>, std::vector<uint32_t>>;
+
+/// Undirected edge -> the faces that have it, for every face of the mesh.
+EdgeFaces edge_faces_of(const geom::TriMesh& m) {
+  EdgeFaces edge_faces;
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = m.faces[f][k], b = m.faces[f][(k + 1) % 3];
       edge_faces[{std::min(a, b), std::max(a, b)}].push_back(uint32_t(f));
     }
-  }
+  return edge_faces;
+}
+
+/// Edge-connected components of the faces with member[f] != 0 (id -1 for the others).
+FaceComponents face_components(const geom::TriMesh& m, const EdgeFaces& edge_faces,
+                               const std::vector<char>& member) {
+  const std::size_t nf = m.faces.size();
   FaceComponents c;
   c.id.assign(nf, -1);
   for (std::size_t f0 = 0; f0 < nf; ++f0) {
@@ -66,8 +73,8 @@ FaceComponents face_components(const geom::TriMesh& m, const std::vector<char>& 
       ++size;
       for (int k = 0; k < 3; ++k) {
         const int a = m.faces[f][k], b = m.faces[f][(k + 1) % 3];
-        for (uint32_t g : edge_faces[{std::min(a, b), std::max(a, b)}])
-          if (c.id[g] < 0) {
+        for (uint32_t g : edge_faces.at({std::min(a, b), std::max(a, b)}))
+          if (member[g] && c.id[g] < 0) {
             c.id[g] = id;
             stack.push_back(g);
           }
@@ -182,7 +189,8 @@ Scalp Scalp::trim(const geom::TriMesh& head, const ScalpCurves& curves, const Sc
     if (!grown) break;
   }
   // 4. Keep the largest edge-connected component.
-  const FaceComponents in = face_components(head, sel);
+  const EdgeFaces edge_faces = edge_faces_of(head);
+  const FaceComponents in = face_components(head, edge_faces, sel);
   const int best = in.largest();
   if (best < 0 || in.size[std::size_t(best)] < 2)
     fail_at("scalp.curves", "the curves enclose no faces of the head mesh");
@@ -193,7 +201,7 @@ Scalp Scalp::trim(const geom::TriMesh& head, const ScalpCurves& curves, const Sc
   // the head) is a hole and joins the scalp.
   std::vector<char> rest(nf, 0);
   for (std::size_t f = 0; f < nf; ++f) rest[f] = comp[f] != best;
-  const FaceComponents out = face_components(head, rest);
+  const FaceComponents out = face_components(head, edge_faces, rest);
   const int outside = out.largest();
   for (std::size_t f = 0; f < nf; ++f)
     if (out.id[f] >= 0 && out.id[f] != outside) comp[f] = best;

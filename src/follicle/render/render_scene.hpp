@@ -218,9 +218,14 @@ struct RenderSettings {
   }
   void validate() const {
     validate_params(*this, "render");
-    if (hair_light_pass != "cpu" && hair_light_pass != "gpu")
-      fail_at("render.hair_light_pass", "unknown value \"{}\"; expected \"cpu\" or \"gpu\"",
-              hair_light_pass);
+    if (const std::string e = hair_light_pass_error(hair_light_pass); !e.empty())
+      fail_at("render.hair_light_pass", "{}", e);
+  }
+  /// Empty when `v` names a hair light-view pass, else what is wrong with it (shared by the
+  /// scene reader, which reports it at the JSON path).
+  static std::string hair_light_pass_error(const std::string& v) {
+    if (v == "cpu" || v == "gpu") return {};
+    return "unknown value \"" + v + "\"; expected \"cpu\" or \"gpu\"";
   }
 };
 

@@ -31,12 +31,7 @@ class LcpRuntime {
   Affine3 last_head = Affine3::Identity();  // head pose at last_frame
   std::shared_ptr<const geom::ParticleSet> last_air;
   std::size_t steps = 0;
-  // With lcp.part: the scenario's model and state stepped by our own solver, so the parting
-  // force can be passed as an external force (LcpScenario::step takes none).
-  std::unique_ptr<hair::LcpSolver> solver;
-  hair::LcpState state;
-  std::unique_ptr<hair::LcpWorkspace> ws;
-  std::vector<Vec3> force;
+  std::vector<Vec3> force;  // with lcp.part: the parting force of the step [N, world]
 };
 
 }  // namespace follicle::scene

@@ -4,6 +4,8 @@
 
 #include <set>
 
+#include "follicle/render/render_scene.hpp"
+
 namespace follicle::scene {
 
 Affine3 Transform::matrix() const {
@@ -29,9 +31,9 @@ void Scene::validate(const JsonSource& src) const {
   if (!(camera.near < camera.far))
     json_fail(src, "camera.far",
               fmt::format("far ({}) must be greater than near ({})", camera.far, camera.near));
-  if (render.hair_light_pass != "cpu" && render.hair_light_pass != "gpu")
-    json_fail(src, "render.hair_light_pass",
-              "unknown value \"" + render.hair_light_pass + "\"; expected \"cpu\" or \"gpu\"");
+  if (const std::string e = render::RenderSettings::hair_light_pass_error(render.hair_light_pass);
+      !e.empty())
+    json_fail(src, "render.hair_light_pass", e);
   std::set<std::string> names;
   for (std::size_t i = 0; i < assets.meshes.size(); ++i) {
     const auto& m = assets.meshes[i];

@@ -120,18 +120,16 @@ std::vector<std::string> Session::export_wrinkle_maps(const std::filesystem::pat
   for (std::size_t ri = 0; ri < m_scene.skin.size(); ++ri) {
     const SkinSpec& spec = m_scene.skin[ri];
     if (!spec.fine) continue;
-    // The relief in metres (rest: the rig's state at frame 0 builds the fields; the rest relief
-    // is M = r everywhere, i.e. no deformation).
+    // The relief in units of depth_m. skin_fine_relief builds the fields and, for a frame,
+    // measures the shrinkage (2.3) of that frame into r.fine_s; the rest relief is M = r
+    // everywhere (no deformation), as is every frame's without modulation.
     (void)skin_fine_relief(ri, std::max(frame, 0));
     const auto& r = skin_runtime().rigs[ri];
     image::ImageF relief;
-    if (frame < 0) {
+    if (frame >= 0 && spec.fine->modulate)
+      r.fine->modulate(*m_ctx, r.fine_s, relief);  // (2.4)
+    else
       r.fine->rest_relief(*m_ctx, relief);
-    } else {
-      relief = *skin_fine_relief(ri, frame);
-      const float inv = r.fine_depth_m > 0 ? float(1.0 / r.fine_depth_m) : 0.0f;
-      for (float& x : relief.storage()) x *= inv;  // metres -> relief units
-    }
     skin::MapExportInfo info;
     info.depth_m = r.fine_depth_m;
     info.metres_per_texel = r.fine->metres_per_texel();

@@ -59,13 +59,6 @@ std::shared_ptr<const geom::ParticleSet> Session::lcp_particles(int frame) {
     }
     rt.head = std::make_shared<const geom::TriMesh>(rt.sim->head());
     rt.state_frame = 0;
-    if (spec.part) {
-      // The scenario's body (voxel planes of the head and torso), model and (settled) state.
-      rt.solver = std::make_unique<hair::LcpSolver>(spec.dynamics, rt.sim->solver().model(),
-                                                    &rt.sim->body());
-      rt.state = rt.sim->state();
-      rt.ws = std::make_unique<hair::LcpWorkspace>();
-    }
     ctx.log().info("lcp: {} particles, {} connections", rt.sim->solver().model().size(),
                    rt.sim->solver().model().num_pairs());
   }
@@ -74,41 +67,31 @@ std::shared_ptr<const geom::ParticleSet> Session::lcp_particles(int frame) {
   while (rt.state_frame < frame) {
     const int f = rt.state_frame + 1;
     for (int k = 0; k < spec.steps_per_frame; ++k) {
-      hair::LcpStepReport rep;
-      if (rt.solver) {  // back hair with the parting force (Fig. 3.7)
-        const auto& model = rt.solver->model();
-        const double a = spec.part->at(rt.state.time);
+      const std::vector<Vec3>* extra = nullptr;
+      if (spec.part) {  // back hair with the parting force (Fig. 3.7), world frame
+        const auto& model = rt.sim->solver().model();
+        const auto& st = rt.sim->state();
+        const double a = spec.part->at(st.time);
         rt.force.assign(model.size(), Vec3::Zero());
         for (std::size_t i = 0; i < model.size(); ++i) {
           if (model.root[i]) continue;
-          const double side = rt.state.x[i].x() >= spec.part->centre_x ? 1.0 : -1.0;
+          const double side = st.x[i].x() >= spec.part->centre_x ? 1.0 : -1.0;
           rt.force[i] = Vec3(side * a * model.mass[i], 0.0, 0.0);
         }
-        hair::LcpStepInput in;
-        in.dt = dt;
-        in.head.t = rt.state.time;
-        in.external_force = &rt.force;
-        rep = rt.solver->step(ctx, in, rt.state, *rt.ws);
-      } else {
-        rep = rt.sim->step(ctx, dt);
+        extra = &rt.force;
       }
+      const hair::LcpStepReport rep = rt.sim->step(ctx, dt, extra);
       ++rt.steps;
       if (!rep.ok)
         fail_at(m_source,
                 "lcp: the simulation failed at frame {} (t = {:.4f} s): {}; try more "
                 "lcp.dynamics.substeps or lcp.steps_per_frame",
-                f, rt.solver ? rt.state.time : rt.sim->time(), rep.message);
+                f, rt.sim->time(), rep.message);
     }
     rt.state_frame = f;
   }
   std::vector<Vec3> x, t;
-  if (rt.solver) {
-    anim::RigidSample still;
-    still.t = rt.state.time;
-    hair::lcp_world(rt.state, still, &x, nullptr, &t);
-  } else {
-    rt.sim->world(x, &t);
-  }
+  rt.sim->world(x, &t);
   auto ps = std::make_shared<geom::ParticleSet>();
   ps->positions.reserve(x.size());
   ps->directions.reserve(t.size());
@@ -118,7 +101,7 @@ std::shared_ptr<const geom::ParticleSet> Session::lcp_particles(int frame) {
   }
   rt.last = std::move(ps);
   rt.last_frame = frame;
-  rt.last_head = rt.solver ? Affine3::Identity() : rt.sim->head_pose().transform();
+  rt.last_head = rt.sim->head_pose().transform();
   rt.last_air.reset();
   if (const auto* air = rt.sim->air(); air && spec.render.show_air) {
     auto ap = std::make_shared<geom::ParticleSet>();

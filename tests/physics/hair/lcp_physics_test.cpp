@@ -201,6 +201,39 @@ TEST(LcpPhysics, BackHairHangsUnderGravityPicture) {
   std::printf("picture: %s\n", (dir / "back_hair.png").c_str());
 }
 
+TEST(LcpPhysics, ScenarioExtraForcePushesTheHair) {
+  // LcpScenario::step's extra force (the parting force of lcp.part) is applied in the world
+  // frame: a steady +x push moves the free hair towards +x against the same scenario without
+  // it; a force array of the wrong size is reported, not applied.
+  Context ctx(2);
+  LcpScenarioParams sp;
+  sp.spacing = 0.02;
+  sp.hair_length = 0.15;
+  LcpScenario still(ctx, sp), pushed(ctx, sp);
+  const auto& m = pushed.solver().model();
+  std::vector<Vec3> f(m.size(), Vec3::Zero());
+  for (std::size_t i = 0; i < m.size(); ++i) f[i] = Vec3(2.0 * 9.81 * m.mass[i], 0, 0);
+  const std::vector<Vec3> wrong(m.size() + 1, Vec3::Zero());
+  const auto bad = pushed.step(ctx, 1.0 / 30, &wrong);
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.message.find("extra forces"), std::string::npos) << bad.message;
+  EXPECT_EQ(pushed.time(), 0.0);
+  for (int k = 0; k < 10; ++k) {
+    ASSERT_TRUE(still.step(ctx, 1.0 / 30).ok);
+    const auto rep = pushed.step(ctx, 1.0 / 30, &f);
+    ASSERT_TRUE(rep.ok) << rep.message;
+  }
+  double dx = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < m.size(); ++i)
+    if (m.uvs[i].z() > 0.08) {
+      dx += pushed.state().x[i].x() - still.state().x[i].x();
+      ++n;
+    }
+  ASSERT_GT(n, 0);
+  EXPECT_GT(dx / n, 0.01) << "mean +x displacement of the lower hair [m]";
+}
+
 TEST(LcpPhysics, WindPushesHairAndHairSlowsWind) {
   // Two-way coupling (§3.6, Fig. 3.9): SPH air blowing along -z through the back hair pushes it
   // downwind, and the air behind the hair is slower than in the same wind without hair.
