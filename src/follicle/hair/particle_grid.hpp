@@ -2,8 +2,11 @@
 // Uniform-grid neighbour search for particles (Bando 2003 §3.3: "a grid of voxels of size 2h").
 // Hand-written rather than a general geom grid because the solvers need (a) neighbour lists in a
 // fixed order that does not depend on the thread count and (b) a rebuild every time step without
-// allocation. Cells are hashed into a table (2 x points, power of two) and points are counting-
-// sorted by bucket, stably by index: the neighbour order is a pure function of the positions.
+// allocation. Cells are hashed into a table (2 x points, power of two); points are counting-sorted
+// by bucket, stably by index, and each bucket is split into its cells, so every occupied cell is
+// one contiguous run of slots holding its points in increasing index order. The candidate order
+// (the 27 cells around a point in z, y, x order, each cell's points by index) is therefore a pure
+// function of the positions and the cell size, independent of the hash and of the thread count.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -14,6 +17,47 @@
 
 namespace follicle::hair {
 
+namespace detail {
+/// Points grouped by integer cell: bucket -> cells (hash collisions share a bucket), cell ->
+/// contiguous slots, slot -> point index (increasing within a cell) and position (SoA).
+struct CellTable {
+  double inv = 1.0;
+  uint32_t mask = 0;
+  std::vector<uint32_t> bucket_cells;            // bucket -> first cell, size buckets + 1
+  std::vector<uint32_t> cell_start;              // cell -> first slot, size cells + 1
+  std::vector<std::array<int, 3>> cell_key;      // integer coordinates of each cell
+  std::vector<uint32_t> sorted;                  // point index of each slot
+  std::vector<double> x, y, z;                   // position of each slot
+  std::vector<uint32_t> start, fill, bucket_of;  // scratch of the build
+  std::vector<std::array<int, 3>> cell_of, cell_sorted;
+
+  void build(const Context* ctx, const std::vector<Vec3>& points, double inv_cell);
+  bool empty() const { return bucket_cells.empty(); }
+  uint32_t bucket(int cx, int cy, int cz) const {
+    uint64_t h = uint64_t(uint32_t(cx)) * 73856093ull ^ uint64_t(uint32_t(cy)) * 19349663ull ^
+                 uint64_t(uint32_t(cz)) * 83492791ull;
+    return uint32_t(h & mask);
+  }
+  /// The cell with these coordinates, or -1 when no point lies in it.
+  int64_t find(int cx, int cy, int cz) const {
+    const uint32_t b = bucket(cx, cy, cz);
+    for (uint32_t c = bucket_cells[b]; c < bucket_cells[b + 1]; ++c) {
+      const auto& k = cell_key[c];
+      if (k[0] == cx && k[1] == cy && k[2] == cz) return int64_t(c);
+    }
+    return -1;
+  }
+};
+
+/// Reused buffers of one chunk of query cells (list building).
+struct ListPart {
+  std::vector<uint32_t> out;  // the chunk's lists, back to back
+  std::vector<double> x, y, z;
+  std::vector<uint32_t> idx;
+  bool mismatch = false;
+};
+}  // namespace detail
+
 class ParticleGrid {
  public:
   /// Buckets `points` into cells of edge `cell` [m].
@@ -22,50 +66,46 @@ class ParticleGrid {
   void build(const Context& ctx, const std::vector<Vec3>& points, double cell);
 
   /// Calls f(j) for every point j in the 27 cells around p (a superset of the points within
-  /// `cell` of p; hash collisions may add far points, callers test the distance). Order is fixed.
+  /// `cell` of p; callers test the distance). Order: cells by (dz, dy, dx) in -1..1 (dx fastest),
+  /// within a cell by increasing index.
   template <class F>
   void for_each_candidate(const Vec3& p, F&& f) const {
-    if (m_mask == 0 && m_start.empty()) return;
-    const int cx = int(std::floor(p.x() * m_inv)), cy = int(std::floor(p.y() * m_inv)),
-              cz = int(std::floor(p.z() * m_inv));
-    // Points are accepted only in their own cell, so a bucket shared by two of the 27 cells
-    // (hash collision) is not visited twice and far points sharing a bucket are skipped early.
+    if (m_cells.empty()) return;
+    const double inv = m_cells.inv;
+    const int cx = int(std::floor(p.x() * inv)), cy = int(std::floor(p.y() * inv)),
+              cz = int(std::floor(p.z() * inv));
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
-          const int x = cx + dx, y = cy + dy, z = cz + dz;
-          const uint32_t b = bucket(x, y, z);
-          for (uint32_t s = m_start[b]; s < m_start[b + 1]; ++s) {
-            const auto& c = m_cell_sorted[s];
-            if (c[0] == x && c[1] == y && c[2] == z) f(m_sorted[s]);
-          }
+          const int64_t c = m_cells.find(cx + dx, cy + dy, cz + dz);
+          if (c < 0) continue;
+          for (uint32_t s = m_cells.cell_start[c]; s < m_cells.cell_start[c + 1]; ++s)
+            f(m_cells.sorted[s]);
         }
   }
 
   /// CSR neighbour lists: for each i, every j != i with |x_j - x_i| < radius (radius <= cell),
-  /// in increasing grid order. Parallel, deterministic.
+  /// in for_each_candidate order. `points` must be the points the grid was built over. Parallel;
+  /// the output does not depend on the thread count. Uses scratch buffers of the grid: do not run
+  /// two list builds on one grid at the same time (for_each_candidate may run concurrently).
   void neighbour_lists(const Context& ctx, const std::vector<Vec3>& points, double radius,
                        std::vector<uint32_t>& offsets, std::vector<uint32_t>& nbrs) const;
 
-  /// Neighbours in another point set (this grid built over `grid_points`) for each query point.
+  /// Neighbours in another point set (this grid built over `grid_points`) for each query point,
+  /// in for_each_candidate order (same conditions as neighbour_lists).
   void cross_lists(const Context& ctx, const std::vector<Vec3>& queries,
                    const std::vector<Vec3>& grid_points, double radius,
                    std::vector<uint32_t>& offsets, std::vector<uint32_t>& nbrs) const;
 
  private:
-  uint32_t bucket(int x, int y, int z) const {
-    uint64_t h = uint64_t(uint32_t(x)) * 73856093ull ^ uint64_t(uint32_t(y)) * 19349663ull ^
-                 uint64_t(uint32_t(z)) * 83492791ull;
-    return uint32_t(h & m_mask);
-  }
-  double m_inv = 1.0;
-  uint32_t m_mask = 0;
-  std::vector<uint32_t> m_start;   // bucket -> first slot, size buckets + 1
-  std::vector<uint32_t> m_sorted;  // point indices by bucket
-  std::vector<uint32_t> m_bucket_of;
-  std::vector<std::array<int, 3>> m_cell_sorted;  // integer cell of each sorted point
-  std::vector<std::array<int, 3>> m_cell_of;      // scratch of the parallel build
-  std::vector<uint32_t> m_fill;                   // scratch of the parallel build
+  void cell_lists(const Context& ctx, const detail::CellTable& q, const std::vector<Vec3>& qpts,
+                  bool self, double r2, std::vector<uint32_t>& offsets,
+                  std::vector<uint32_t>& nbrs) const;
+
+  detail::CellTable m_cells;
+  mutable detail::CellTable m_query_cells;            // cross_lists: the query points by cell
+  mutable std::vector<detail::ListPart> m_parts;      // per chunk of query cells
+  mutable std::vector<uint32_t> m_part_of, m_pos_of;  // where each query's list was written
 };
 
 /// Sorts each CSR list by neighbour index and fills mirror[e] with the entry (j -> i) of every
