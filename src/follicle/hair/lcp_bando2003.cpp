@@ -710,17 +710,22 @@ void LcpSolver::active_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& 
   const double r2max = 4 * m_model.h * m_model.h;
   const Vec3 xi = s.x[i];
   const uint32_t e0 = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
-  uint32_t k = e0;
+  // Interacting entries are listed from e0 upwards, the others from e1 downwards; both cursors
+  // write every entry into the free slots [lo, hi) and one of them advances.
+  uint32_t lo = e0, hi = e1;
   for (uint32_t e = e0; e < e1; ++e) {
     const double d2 = (s.x[ws.nbrs[e]] - xi).squaredNorm();
     const double w = K.w(std::sqrt(d2));
     const bool inside = d2 < r2max;
     ws.pair_w[e] = inside ? w : 0.0;
-    ws.pair_f[e] = Vec3::Zero();
-    ws.pair_act[k] = e;
-    k += (inside && d2 > 0) ? 1u : 0u;
+    const uint32_t act = (inside && d2 > 0) ? 1u : 0u;
+    ws.pair_act[lo] = e;
+    ws.pair_act[hi - 1] = e;
+    lo += act;
+    hi -= 1u - act;
   }
-  ws.act_end[i] = k;
+  ws.act_end[i] = lo;
+  for (uint32_t k = lo; k < e1; ++k) ws.pair_f[ws.pair_act[k]] = Vec3::Zero();
 }
 
 void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,

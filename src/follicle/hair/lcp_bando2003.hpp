@@ -179,7 +179,8 @@ struct LcpWorkspace {
   std::size_t nbr_builds = 0;        // number of list builds (statistics)
   std::vector<double> pair_w;        // W(h, r) per entry with i < j
   std::vector<Vec3> pair_f;          // hair-hair force on i per entry with i < j [N]
-  // Entries (i < j) with 0 < r < 2h, compacted per particle into [nbr_upper[i], act_end[i]).
+  // Entries (i < j) with 0 < r < 2h, compacted per particle into [nbr_upper[i], act_end[i]);
+  // the other entries of the upper list follow, up to nbr_offsets[i + 1].
   std::vector<uint32_t> pair_act, act_end;
   std::vector<Vec3> spring_f;       // spring force on the root-side end per connection [N]
   std::vector<double> p_rho2;       // P_i / rho_i^2 per particle

@@ -78,11 +78,67 @@ VoxelPlanes VoxelPlanes::build(const std::vector<const geom::TriMesh*>& meshes,
     pl.n = e.n / nn;
     vp.m_planes.emplace(k, pl);
   }
+  vp.build_dense_index();
   return vp;
+}
+
+void VoxelPlanes::build_dense_index() {
+  m_dense.clear();
+  m_dense_planes.clear();
+  if (m_planes.empty()) return;
+  auto unkey = [](uint64_t k) {
+    auto g = [](uint64_t v) { return int(v & 0x1FFFFFu) - (1 << 20); };
+    return Eigen::Vector3i(g(k), g(k >> 21), g(k >> 42));
+  };
+  Eigen::Vector3i lo = unkey(m_planes.begin()->first), hi = lo;
+  for (const auto& [k, pl] : m_planes) {
+    const Eigen::Vector3i c = unkey(k);
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  const Eigen::Vector3i dim = hi - lo + Eigen::Vector3i::Ones();
+  const std::size_t cells = std::size_t(dim.x()) * std::size_t(dim.y()) * std::size_t(dim.z());
+  if (cells > kMaxDenseCells) return;  // a sparse body over a large box: hash lookups
+  m_lo = lo;
+  m_dim = dim;
+  m_dense.assign(cells, -1);
+  m_dense_planes.reserve(m_planes.size());
+  for (const auto& [k, pl] : m_planes) {
+    const Eigen::Vector3i c = unkey(k) - lo;
+    m_dense[(std::size_t(c.z()) * std::size_t(dim.y()) + std::size_t(c.y())) *
+                std::size_t(dim.x()) +
+            std::size_t(c.x())] = int32_t(m_dense_planes.size());
+    m_dense_planes.push_back(pl);
+  }
 }
 
 const BodyPlane* VoxelPlanes::find(const Vec3& x) const {
   if (m_planes.empty()) return nullptr;
+  if (!m_dense.empty()) {
+    // The same cell as cell(x) (the same division), range-checked before the conversion so a
+    // point outside the box (or NaN) is simply "no plane".
+    const double f[3] = {x.x() / m_size, x.y() / m_size, x.z() / m_size};
+    int c[3];
+    for (int a = 0; a < 3; ++a) {
+      const double rel = f[a] - double(m_lo[a]);
+      if (!(rel >= 0.0 && rel < double(m_dim[a]))) return nullptr;
+      // floor(f) - lo without a libm call: f - lo is in [0, dim) here, so truncation is floor,
+      // except where f is an integer and f - lo rounds differently: compare against the
+      // integer cell of f itself.
+      int i = int(rel);
+      const double fl = double(m_lo[a] + i);
+      if (fl > f[a])
+        --i;
+      else if (fl + 1.0 <= f[a])
+        ++i;
+      if (i < 0 || i >= m_dim[a]) return nullptr;
+      c[a] = i;
+    }
+    const int32_t k = m_dense[(std::size_t(c[2]) * std::size_t(m_dim.y()) + std::size_t(c[1])) *
+                                  std::size_t(m_dim.x()) +
+                              std::size_t(c[0])];
+    return k < 0 ? nullptr : &m_dense_planes[std::size_t(k)];
+  }
   auto it = m_planes.find(key(cell(x)));
   return it == m_planes.end() ? nullptr : &it->second;
 }

@@ -66,9 +66,17 @@ class VoxelPlanes {
  private:
   static uint64_t key(const Eigen::Vector3i& c);
   Eigen::Vector3i cell(const Vec3& x) const;
+  void build_dense_index();
   double m_size = 0.01;
   std::size_t m_num_samples = 0;
   std::unordered_map<uint64_t, BodyPlane> m_planes;
+  // Dense lookup over the bounding box of the occupied voxels (when it has at most
+  // kMaxDenseCells cells): find() runs per particle and sub-step, and an array index is several
+  // times cheaper than hashing. m_dense holds -1 or an index into m_dense_planes.
+  static constexpr std::size_t kMaxDenseCells = std::size_t(1) << 22;
+  std::vector<int32_t> m_dense;
+  std::vector<BodyPlane> m_dense_planes;
+  Eigen::Vector3i m_lo = Eigen::Vector3i::Zero(), m_dim = Eigen::Vector3i::Zero();
 };
 
 /// Contact response of one particle against a body plane, in accelerations (force per unit mass,
