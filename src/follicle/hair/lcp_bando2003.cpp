@@ -459,12 +459,6 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
       fail_at(fmt::format("lcp.adjacency[{}]", e), "connection index out of range");
   m_rho0 = m_params.rho0_scale * m_model.rest_density;
   m_ks = SphKernel(m_model.h_s);
-  m_sin_a.resize(m_model.num_pairs());
-  m_sin_b.resize(m_model.num_pairs());
-  for (std::size_t q = 0; q < m_model.num_pairs(); ++q) {
-    m_sin_a[q] = std::sqrt(std::max(0.0, 1 - m_model.cos_a[q] * m_model.cos_a[q]));
-    m_sin_b[q] = std::sqrt(std::max(0.0, 1 - m_model.cos_b[q] * m_model.cos_b[q]));
-  }
   m_ea.resize(n);
   for (std::size_t i = 0; i < n; ++i) m_ea[i] = m_params.elastic_modulus * cross_section(i);
   // Connections of each particle by its role (pair_b == i: root-side partner; pair_a == i:
@@ -482,8 +476,9 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
         pairs.push_back(q);
         // cos theta0_ij against x_ij = x_j - x_i: +cos_a at the root-side end, -cos_b at the
         // tip-side end (x_ij = -x_ab there).
-        cs.push_back(as_b ? -m_model.cos_b[q] : m_model.cos_a[q]);
-        sn.push_back(as_b ? m_sin_b[q] : m_sin_a[q]);
+        const double c0 = as_b ? m_model.cos_b[q] : m_model.cos_a[q];
+        cs.push_back(as_b ? -c0 : c0);
+        sn.push_back(std::sqrt(std::max(0.0, 1 - c0 * c0)));  // sin theta0 of this end
       }
       off[i + 1] = uint32_t(pairs.size());
     }
@@ -918,8 +913,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.conn_r.resize(np);
   ws.conn_xh.resize(np);
   ws.geom_owner = nullptr;  // set again below once it matches s.x
-  auto geometry_of = [&](std::size_t i) { this->geometry_of(i, s, ws); };
-  if (!geom_valid) parallel_for(ctx, 0, n, geometry_of);
+  if (!geom_valid) parallel_for(ctx, 0, n, [&](std::size_t i) { geometry_of(i, s, ws); });
   // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
   // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
   int nsub = P.substeps;
@@ -1069,7 +1063,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
       LcpWorkspace::ChunkCheck c;
       for (std::size_t i = i0; i < i1; ++i) {
-        this->geometry_of(i, s, ws);
+        geometry_of(i, s, ws);
         direction_of(i, s, ws, true);
         const double sp = s.v[i].norm();
         const bool bad =

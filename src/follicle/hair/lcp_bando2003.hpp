@@ -290,8 +290,7 @@ class LcpSolver {
   std::vector<double> m_rs_cos, m_rs_sin, m_ts_cos, m_ts_sin;
   std::vector<double> m_damp;  // 2 zeta sqrt(mu_ab) per connection (spring damping factor)
   LcpParams m_params;
-  std::vector<double> m_ea;              // E A_i per particle ((3.9) with the constant modulus)
-  std::vector<double> m_sin_a, m_sin_b;  // sin theta0 per connection end (for (3.15))
+  std::vector<double> m_ea;  // E A_i per particle ((3.9) with the constant modulus)
   LcpModel m_model;
   const sim::VoxelPlanes* m_body = nullptr;
   double m_rho0 = 0;

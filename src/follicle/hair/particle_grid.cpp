@@ -324,42 +324,23 @@ bool sort_then_match(const Context& ctx, const std::vector<uint32_t>& offsets,
 
 /// Transposes the CSR lists `in` into `out` (same offsets): row j of out gets every i with j in
 /// row i of in, by increasing i. When `pos` is given, pos[e] receives the slot of out that entry
-/// e of in went to. Returns false when a row of out would overflow or an index is >= n (then the
-/// lists are not symmetric). Target rows are split into ranges, one per task, each task scanning
-/// all of `in` (the result does not depend on the split).
-bool transpose(const Context& ctx, const std::vector<uint32_t>& offsets, const uint32_t* in,
-               uint32_t* out, uint32_t* pos, const uint32_t* expect) {
+/// e of in went to; with `expect`, every slot must already hold the i that goes there. Returns
+/// false when a row of out would overflow, an index is >= n or `expect` differs (then the lists
+/// are not symmetric). Serial: one pass over the entries; two threads each scanning all entries
+/// for half of the rows measured slower (memory bound).
+bool transpose(const std::vector<uint32_t>& offsets, const uint32_t* in, uint32_t* out,
+               uint32_t* pos, const uint32_t* expect) {
   const std::size_t n = offsets.size() - 1;
-  // One task: two tasks each scanning all entries measured slower than one (memory bound).
-  const std::size_t parts = 1;
   std::vector<uint32_t> cursor(offsets.begin(), offsets.end() - 1);
-  std::vector<int> ok(parts, 1);
-  parallel_for(
-      ctx, 0, parts,
-      [&](std::size_t part) {
-        const uint32_t lo = uint32_t(n * part / parts), hi = uint32_t(n * (part + 1) / parts);
-        const bool last = part + 1 == parts;
-        int good = 1;
-        for (std::size_t i = 0; i < n && good; ++i)
-          for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
-            const uint32_t j = in[e];
-            if (j < lo || j >= hi) {
-              if (last && j >= hi) good = 0;  // index beyond the particles
-              continue;
-            }
-            const uint32_t c = cursor[j]++;
-            if (c >= offsets[j + 1] || (expect && expect[c] != i)) {
-              good = 0;
-              break;
-            }
-            if (out) out[c] = uint32_t(i);
-            if (pos) pos[e] = c;
-          }
-        ok[part] = good;
-      },
-      1);
-  for (int g : ok)
-    if (!g) return false;
+  for (std::size_t i = 0; i < n; ++i)
+    for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
+      const uint32_t j = in[e];
+      if (j >= n) return false;  // index beyond the particles
+      const uint32_t c = cursor[j]++;
+      if (c >= offsets[j + 1] || (expect && expect[c] != i)) return false;
+      if (out) out[c] = uint32_t(i);
+      if (pos) pos[e] = c;
+    }
   return true;
 }
 }  // namespace
@@ -376,12 +357,12 @@ bool sort_and_mirror(const Context& ctx, const std::vector<uint32_t>& offsets,
   if (n == 0 || offsets[n] != nbrs.size() || offsets[0] != 0)
     return sort_then_match(ctx, offsets, nbrs, mirror);
   mirror.resize(nbrs.size());
-  if (!transpose(ctx, offsets, nbrs.data(), mirror.data(), nullptr, nullptr))
+  if (!transpose(offsets, nbrs.data(), mirror.data(), nullptr, nullptr))
     return sort_then_match(ctx, offsets, nbrs, mirror);  // nbrs untouched
   // mirror holds T; nbrs' storage receives T's mirror entries.
-  if (!transpose(ctx, offsets, mirror.data(), nullptr, nbrs.data(), mirror.data())) {
+  if (!transpose(offsets, mirror.data(), nullptr, nbrs.data(), mirror.data())) {
     // Not symmetric: rebuild the lists as the transpose of T, then take the reference path.
-    transpose(ctx, offsets, mirror.data(), nbrs.data(), nullptr, nullptr);
+    transpose(offsets, mirror.data(), nbrs.data(), nullptr, nullptr);
     return sort_then_match(ctx, offsets, nbrs, mirror);
   }
   nbrs.swap(mirror);
