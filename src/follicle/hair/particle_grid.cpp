@@ -1,6 +1,7 @@
 #include "follicle/hair/particle_grid.hpp"
 
 #include <algorithm>
+#include <atomic>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -304,7 +305,11 @@ bool sort_then_match(const Context& ctx, const std::vector<uint32_t>& offsets,
   for (std::size_t i = 0; i < n; ++i)
     for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
       const uint32_t j = nbrs[e];
-      if (j <= i) continue;
+      if (j == i) {  // a self entry: no pair, and its mirror would alias pair 0
+        mirror.clear();
+        return false;
+      }
+      if (j < i) continue;
       const uint32_t c = j < n ? cursor[j]++ : 0;
       if (j >= n || c >= offsets[j + 1] || nbrs[c] != i) {
         mirror.clear();
@@ -366,14 +371,20 @@ bool sort_and_mirror(const Context& ctx, const std::vector<uint32_t>& offsets,
     return sort_then_match(ctx, offsets, nbrs, mirror);
   }
   nbrs.swap(mirror);
-  // Self entries (i in list i) keep mirror 0 as in the cursor algorithm.
+  // A self entry (i in list i) is its own transpose, so it passes the symmetry check; it is no
+  // pair and is rejected like an asymmetric list.
+  std::atomic<bool> self{false};
   parallel_for(
       ctx, 0, n,
       [&](std::size_t i) {
         for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e)
-          if (nbrs[e] == i) mirror[e] = 0;
+          if (nbrs[e] == i) self.store(true, std::memory_order_relaxed);
       },
       4096);
+  if (self.load()) {
+    mirror.clear();
+    return false;
+  }
   return true;
 }
 

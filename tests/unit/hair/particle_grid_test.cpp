@@ -268,7 +268,11 @@ bool reference_sort_and_mirror(const std::vector<uint32_t>& off, std::vector<uin
   for (std::size_t i = 0; i < n; ++i)
     for (uint32_t e = off[i]; e < off[i + 1]; ++e) {
       const uint32_t j = nb[e];
-      if (j <= i) continue;
+      if (j == i) {  // a self entry is no pair
+        mirror.clear();
+        return false;
+      }
+      if (j < i) continue;
       if (j >= n || cursor[j] >= off[j + 1] || nb[cursor[j]] != i) {
         mirror.clear();
         return false;
@@ -328,4 +332,13 @@ TEST(ParticleGrid, SortAndMirrorPairsEveryEntryAndRejectsAsymmetricLists) {
   check({0, 2, 3}, {1, 1, 0});
   check({0, 1, 1}, {1});
   check({0, 0, 1}, {0});
+  // Self entries: symmetric as lists (an entry i in list i is its own transpose) but no pair;
+  // gathering them through the mirror index read pair 0's force and kernel value.
+  check({0, 1, 2}, {0, 1});
+  check({0, 2, 3}, {0, 1, 0});
+  o = off;
+  n = nb0;
+  n.insert(n.begin() + o[50], 50);
+  for (std::size_t i = 51; i < o.size(); ++i) ++o[i];
+  check(o, n);
 }
