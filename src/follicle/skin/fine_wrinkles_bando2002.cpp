@@ -249,6 +249,37 @@ class CapsuleRows {
   Linear m_along{}, m_across{};
 };
 
+/// The rows of a stroke of half-width r from a to b on a w x h texel grid (rows ylo .. yhi - 1
+/// only): image/raster.cpp's box (r + 1 around the segment) intersected row by row with the
+/// capsule of radius `reach` about the segment. Calls row(y, yc, x0, x1) for every row whose
+/// span [x0, x1] is not empty, after prefetching that span two rows ahead in `grid` (the rows are
+/// cache misses). Returns false (nothing visited) for non-finite input.
+template <class T, class Row>
+bool for_segment_rows(int w, int h, const Vec2& a, const Vec2& b, double r, double reach,
+                      const T* grid, int ylo, int yhi, Row&& row) {
+  if (!a.allFinite() || !b.allFinite() || !std::isfinite(r) || r < 0) return false;
+  const int bx0 = std::max(0, ifloor(std::min(a.x(), b.x()) - r - 1));
+  const int by0 = std::max(ylo, ifloor(std::min(a.y(), b.y()) - r - 1));
+  const int bx1 = std::min(w - 1, iceil(std::max(a.x(), b.x()) + r + 1));
+  const int by1 = std::min({h - 1, yhi - 1, iceil(std::max(a.y(), b.y()) + r + 1)});
+  if (bx0 > bx1 || by0 > by1) return true;
+  const CapsuleRows cap(a, b, reach);
+  for (int y = by0; y <= by1; ++y) {
+    const double yc = y + 0.5;
+    int x0, x1;
+    if (!cap.span(yc, w, x0, x1)) continue;
+    x0 = std::max(x0, bx0);
+    x1 = std::min(x1, bx1);
+    if (y + 2 <= by1) {
+      const T* ahead = grid + (std::size_t(y) + 2) * std::size_t(w);
+      __builtin_prefetch(ahead + x0);
+      __builtin_prefetch(ahead + x1);
+    }
+    row(y, yc, x0, x1);
+  }
+  return true;
+}
+
 /// The texels of image::draw_line(img, a, b, width, ...) with their coverage: calls
 /// f(texel index, cov) for every texel with cov > 0, with the same distance and coverage
 /// arithmetic as image/raster.cpp, so blending gives the same values texel for texel. Visits in
@@ -259,42 +290,24 @@ template <class F>
 bool visit_segment(int w, int h, const Vec2& a, const Vec2& b, double width, const float* img,
                    F&& f, int ylo = 0, int yhi = std::numeric_limits<int>::max()) {
   const double r = 0.5 * width;
-  if (!a.allFinite() || !b.allFinite() || !std::isfinite(r) || r < 0) return false;
-  // draw_polyline's box (r + 1 around the segment).
-  const int bx0 = std::max(0, ifloor(std::min(a.x(), b.x()) - r - 1));
-  const int by0 = std::max(ylo, ifloor(std::min(a.y(), b.y()) - r - 1));
-  const int bx1 = std::min(w - 1, iceil(std::max(a.x(), b.x()) + r + 1));
-  const int by1 = std::min({h - 1, yhi - 1, iceil(std::max(a.y(), b.y()) + r + 1)});
-  if (bx0 > bx1 || by0 > by1) return true;
   const Vec2 ab = b - a;
   const double l2 = ab.squaredNorm();
   // Coverage needs d < r + 0.5.
   const double out = r + 0.5 + 1e-6, out2 = out * out;
-  const CapsuleRows cap(a, b, out);
-  for (int y = by0; y <= by1; ++y) {
-    const double yc = y + 0.5;
-    int x0, x1;
-    if (!cap.span(yc, w, x0, x1)) continue;
-    x0 = std::max(x0, bx0);
-    x1 = std::min(x1, bx1);
+  return for_segment_rows(w, h, a, b, r, out, img, ylo, yhi, [&](int y, double yc, int x0, int x1) {
     const std::size_t rowi = std::size_t(y) * std::size_t(w);
-    if (y + 2 <= by1) {  // the rows are cache misses: start loading two rows ahead
-      __builtin_prefetch(img + rowi + 2 * std::size_t(w) + x0);
-      __builtin_prefetch(img + rowi + 2 * std::size_t(w) + x1);
-    }
     for (int x = x0; x <= x1; ++x) {
       // image/raster.cpp seg_dist and coverage, the same expressions.
       const Vec2 p(x + 0.5, yc);
       double t = l2 > 0 ? (p - a).dot(ab) / l2 : 0.0;
       t = std::clamp(t, 0.0, 1.0);
       const double d2 = (p - (a + t * ab)).squaredNorm();
-      if (d2 >= out2) continue;  // d >= r + 0.5: no coverage (skips the square root)
+      if (d2 >= out2) continue;  // d >= r + 0.5: no coverage (no sqrt)
       const double d = std::sqrt(d2);
       const double cov = std::clamp(0.5 + r - d, 0.0, 1.0);
       if (cov > 0) f(rowi + std::size_t(x), cov);
     }
-  }
-  return true;
+  });
 }
 
 /// Occupancy (§2.6.2 step 6): sets occ[i] = 1 where image::draw_line(.., width, 1.0f,
@@ -303,27 +316,11 @@ bool visit_segment(int w, int h, const Vec2& a, const Vec2& b, double width, con
 /// the exact coverage expression, so the result is the same texel for texel.
 void mark_segment(int n, const Vec2& a, const Vec2& b, double width, uint8_t* occ) {
   const double r = 0.5 * width, m = 1e-6;
-  if (!a.allFinite() || !b.allFinite() || !std::isfinite(r) || r < 0) return;
   const double in2 = r > m ? (r - m) * (r - m) : -1.0, out2 = (r + m) * (r + m);
-  const int bx0 = std::max(0, ifloor(std::min(a.x(), b.x()) - r - 1));
-  const int by0 = std::max(0, ifloor(std::min(a.y(), b.y()) - r - 1));
-  const int bx1 = std::min(n - 1, iceil(std::max(a.x(), b.x()) + r + 1));
-  const int by1 = std::min(n - 1, iceil(std::max(a.y(), b.y()) + r + 1));
-  if (bx0 > bx1 || by0 > by1) return;
   const Vec2 ab = b - a;
   const double l2 = ab.squaredNorm();
-  const CapsuleRows cap(a, b, r + m);
-  for (int y = by0; y <= by1; ++y) {
-    const double yc = y + 0.5;
-    int x0, x1;
-    if (!cap.span(yc, n, x0, x1)) continue;
-    x0 = std::max(x0, bx0);
-    x1 = std::min(x1, bx1);
+  for_segment_rows(n, n, a, b, r, r + m, occ, 0, n, [&](int y, double yc, int x0, int x1) {
     uint8_t* row = occ + std::size_t(y) * std::size_t(n);
-    if (y + 2 <= by1) {  // the rows are cache misses: start loading two rows ahead
-      __builtin_prefetch(row + 2 * std::size_t(n) + x0);
-      __builtin_prefetch(row + 2 * std::size_t(n) + x1);
-    }
     // Texel x: true when it lies in the core (d <= r - 1e-6); otherwise marks it by the exact
     // coverage rule.
     auto core = [&](int x) {
@@ -342,11 +339,11 @@ void mark_segment(int n, const Vec2& a, const Vec2& b, double width, uint8_t* oc
     // from both ends of the span to the run and fill it without evaluating it.
     int xl = x0;
     while (xl <= x1 && !core(xl)) ++xl;
-    if (xl > x1) continue;
+    if (xl > x1) return;
     int xr = x1;
     while (xr > xl && !core(xr)) --xr;
     std::memset(row + xl, 1, std::size_t(xr - xl + 1));
-  }
+  });
 }
 
 }  // namespace
