@@ -1,22 +1,8 @@
 // Google Benchmark front-end for the Anjyo 1992 workloads (same factories as `follicle bench`).
-#include <benchmark/benchmark.h>
-
-#include "follicle/core/context.hpp"
-#include "workloads/workload.hpp"
-
-namespace follicle::workloads {
-void add_anjyo_workloads(std::vector<Workload>& out);
-}
+#include "bench_common.hpp"
 
 static void run_anjyo(benchmark::State& state, const char* name) {
-  using namespace follicle::workloads;
-  std::vector<Workload> all;
-  add_anjyo_workloads(all);
-  const Workload& w = find_workload(all, name);
-  follicle::Context ctx(int(state.range(0)));
-  auto inst = w.make(ctx, w.default_sizes);
-  for (auto _ : state) inst->run_once();
-  state.SetItemsProcessed(int64_t(double(state.iterations()) * inst->items_per_iter()));
+  follicle::bench::run_workload(state, name, {}, int(state.range(0)));
 }
 
 static void BM_AnjyoStyle(benchmark::State& s) {

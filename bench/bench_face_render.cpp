@@ -1,27 +1,11 @@
 // Face rendering benchmarks: the "face-render" workload (wrinkled default head, Lafortune skin
 // BRDF, 640x480 headless), render only and with the face update every frame.
-#include <benchmark/benchmark.h>
-
-#include "follicle/core/context.hpp"
-#include "workloads/workload.hpp"
+#include "bench_common.hpp"
 
 namespace {
 
-void run_face_render(benchmark::State& state, follicle::workloads::Sizes sizes) {
-  using namespace follicle::workloads;
-  follicle::Context ctx(0);
-  const auto all = all_workloads();
-  const Workload& w = find_workload(all, "face-render");
-  std::unique_ptr<WorkloadInstance> inst;
-  try {
-    inst = w.make(ctx, resolve_sizes(w, sizes));
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
-  for (auto _ : state) inst->run_once();
-  state.counters[w.throughput_unit] = benchmark::Counter(
-      double(state.iterations()) * inst->items_per_iter(), benchmark::Counter::kIsRate);
+void run_face_render(benchmark::State& state, const follicle::workloads::Sizes& sizes) {
+  follicle::bench::run_workload(state, "face-render", sizes);
 }
 
 void BM_FaceRender(benchmark::State& state) {

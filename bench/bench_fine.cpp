@@ -1,27 +1,11 @@
 // Fine-scale wrinkle benchmarks: the same workloads as `follicle bench fine-wrinkles`,
 // `fine-modulation` and `hand-update`.
-#include <benchmark/benchmark.h>
-
-#include "follicle/core/context.hpp"
-#include "workloads/workload.hpp"
+#include "bench_common.hpp"
 
 namespace {
 
-void run_fine(benchmark::State& state, const char* name, int threads) {
-  using namespace follicle::workloads;
-  follicle::Context ctx(threads);
-  const auto all = all_workloads();
-  const Workload& w = find_workload(all, name);
-  std::unique_ptr<WorkloadInstance> inst;
-  try {
-    inst = w.make(ctx, resolve_sizes(w, {}));
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
-  for (auto _ : state) inst->run_once();
-  state.counters[w.throughput_unit] = benchmark::Counter(
-      double(state.iterations()) * inst->items_per_iter(), benchmark::Counter::kIsRate);
+void run_fine(benchmark::State& s, const char* name, int threads) {
+  follicle::bench::run_workload(s, name, {}, threads);
 }
 
 void BM_FineWrinkles(benchmark::State& s) {

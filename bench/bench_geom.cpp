@@ -1,23 +1,13 @@
 // Geometry benchmarks: the same workloads as `follicle bench mesh-load|closest-point|
 // neighbour-search`. Arguments: the size (queries or particles) and the thread count.
-#include <benchmark/benchmark.h>
-
-#include "follicle/core/context.hpp"
-#include "workloads/workload.hpp"
+#include "bench_common.hpp"
 
 namespace {
 
-using namespace follicle;
-using namespace follicle::workloads;
+using follicle::workloads::Sizes;
 
 void run(benchmark::State& state, const char* name, const Sizes& sizes, int threads) {
-  const auto all = all_workloads();
-  const Workload& w = find_workload(all, name);
-  Context ctx(threads);
-  auto inst = w.make(ctx, resolve_sizes(w, sizes));
-  for (auto _ : state) inst->run_once();
-  state.counters["items_per_s"] = benchmark::Counter(
-      inst->items_per_iter() * double(state.iterations()), benchmark::Counter::kIsRate);
+  follicle::bench::run_workload(state, name, sizes, threads);
 }
 
 void BM_MeshLoad(benchmark::State& state) {

@@ -1,26 +1,10 @@
 // Hair rendering benchmark: the same workload as `follicle bench hair-render`.
-#include <benchmark/benchmark.h>
-
-#include "follicle/core/context.hpp"
-#include "workloads/workload.hpp"
+#include "bench_common.hpp"
 
 namespace {
 
 void BM_HairRender(benchmark::State& state) {
-  using namespace follicle::workloads;
-  follicle::Context ctx(0);
-  const auto all = all_workloads();
-  std::unique_ptr<WorkloadInstance> inst;
-  try {
-    const Workload& w = find_workload(all, "hair-render");
-    inst = w.make(ctx, resolve_sizes(w, {{"strands", double(state.range(0))}}));
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
-  for (auto _ : state) inst->run_once();
-  state.counters["strands/s"] = benchmark::Counter(
-      double(state.iterations()) * inst->items_per_iter(), benchmark::Counter::kIsRate);
+  follicle::bench::run_workload(state, "hair-render", {{"strands", double(state.range(0))}});
 }
 
 }  // namespace

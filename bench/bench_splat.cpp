@@ -1,27 +1,9 @@
 // Hair splat rendering benchmarks: the same workload as `follicle bench lcp-render`.
-#include <benchmark/benchmark.h>
-
-#include "follicle/core/context.hpp"
-#include "workloads/workload.hpp"
+#include "bench_common.hpp"
 
 namespace {
 
-void run_workload(benchmark::State& state, const char* name, follicle::workloads::Sizes sizes) {
-  using namespace follicle::workloads;
-  follicle::Context ctx(0);
-  const auto all = all_workloads();
-  const Workload& w = find_workload(all, name);
-  std::unique_ptr<WorkloadInstance> inst;
-  try {
-    inst = w.make(ctx, resolve_sizes(w, sizes));
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
-  for (auto _ : state) inst->run_once();
-  state.counters[w.throughput_unit] = benchmark::Counter(
-      double(state.iterations()) * inst->items_per_iter(), benchmark::Counter::kIsRate);
-}
+using follicle::bench::run_workload;
 
 // The target: 2,000 particles, self-shadowing, 512^2.
 void BM_LcpRender(benchmark::State& state) {
