@@ -816,19 +816,17 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
   parallel_for(ctx, 0, n, [&](std::size_t i) { ws.force[i] = gather_of(i, ws, hh); });
 }
 
-void LcpSolver::geometry_of(std::size_t i, const LcpState& s, LcpWorkspace& ws) const {
-  // |x_ab| and x^_ab of the connections of which i is the tip-side end b.
-  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
-    const uint32_t q = m_rs_pairs[e];
-    const Vec3 d = s.x[i] - s.x[m_model.pair_a[q]];  // x_ab, b = i
-    const double r = d.norm();
-    ws.conn_r[q] = r;
-    ws.conn_xh[q] = d * (1.0 / r);
-  }
+void LcpSolver::geometry_of(std::size_t q, const LcpState& s, LcpWorkspace& ws) const {
+  // |x_ab| and x^_ab of connection q. direction_of computes the same expression when it does
+  // not read the cache, so both give the same bits.
+  const Vec3 d = s.x[m_model.pair_b[q]] - s.x[m_model.pair_a[q]];  // x_ab
+  const double r = d.norm();
+  ws.conn_r[q] = r;
+  ws.conn_xh[q] = d * (1.0 / r);
 }
 
 void LcpSolver::direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws,
-                             bool cached_rs) const {
+                             bool cached) const {
   const auto& m = m_model;
   if (m.root[i]) return;
   const Vec3 ti = s.t[i];
@@ -842,9 +840,9 @@ void LcpSolver::direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws,
   Vec3 acc = Vec3::Zero();
   double bsum = 0;
   // The geometry of a connection is either read from ws.conn_r / conn_xh (filled by
-  // geometry_of at the tip-side end) or computed here by the same expression, so both ends see
-  // it bit for bit (x_ji = -x_ij exactly).
-  auto add = [&](uint32_t q, double sign, double c0, double s0, bool cached) {
+  // geometry_of) or computed here by the same expression, so both ends see it bit for bit
+  // (x_ji = -x_ij exactly).
+  auto add = [&](uint32_t q, double sign, double c0, double s0) {
     double r;
     Vec3 xh;  // x^_ij
     if (cached) {
@@ -864,9 +862,9 @@ void LcpSolver::direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws,
     bsum += sp;
   };
   for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e)
-    add(m_ts_pairs[e], 1.0, m_ts_cos[e], m_ts_sin[e], false);
+    add(m_ts_pairs[e], 1.0, m_ts_cos[e], m_ts_sin[e]);
   for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e)
-    add(m_rs_pairs[e], -1.0, m_rs_cos[e], m_rs_sin[e], cached_rs);
+    add(m_rs_pairs[e], -1.0, m_rs_cos[e], m_rs_sin[e]);
   acc += bsum * ti;
   const double an = acc.norm();
   if (an > 1e-300 && std::isfinite(an)) s.t[i] = acc / an;
@@ -913,7 +911,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.conn_r.resize(np);
   ws.conn_xh.resize(np);
   ws.geom_owner = nullptr;  // set again below once it matches s.x
-  if (!geom_valid) parallel_for(ctx, 0, n, [&](std::size_t i) { geometry_of(i, s, ws); });
+  if (!geom_valid) parallel_for(ctx, 0, np, [&](std::size_t q) { geometry_of(q, s, ws); });
   // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
   // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
   int nsub = P.substeps;
@@ -1009,14 +1007,16 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       alpha_sweeps(ctx, ws);
     }
     const bool alpha_here = do_alpha && P.alpha_sweeps == 0;
-    // 3. alpha (3.14), springs and hair-hair forces, once per connection / pair.
-    parallel_for(ctx, 0, n, [&](std::size_t i) {
-      if (alpha_here) alpha_of(i, ws);
-      for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
-        const uint32_t q = m_rs_pairs[e];
-        spring_of(q, s, ws, ws.conn_r[q], ws.conn_xh[q]);
+    // 3. alpha (3.14) and springs once per connection (indices 0 .. np - 1), hair-hair forces
+    // once per pair (particle i at index np + i): one parallel loop over both.
+    parallel_for(ctx, 0, np + (hh ? n : 0), [&](std::size_t k) {
+      if (k < np) {
+        if (alpha_here)  // (3.14): a is root-side (in N_r(b)), b is tip-side (in N_t(a))
+          ws.alpha[k] = 0.5 * (ws.alpha_r[m.pair_b[k]] + ws.alpha_t[m.pair_a[k]]);
+        spring_of(k, s, ws, ws.conn_r[k], ws.conn_xh[k]);
+      } else {
+        hair_pairs_of(k - np, s, ws, K, inv_w0);
       }
-      if (hh) hair_pairs_of(i, s, ws, K, inv_w0);
     });
     // 4. Gather, accelerations and the leapfrog update (each particle reads only its own state
     // besides the per-pair forces): v(t + dt/2) = v(t - dt/2) + a(t) dt, x(t + dt) = x(t) +
@@ -1056,14 +1056,13 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       s.v[i] += a * dt;
       s.x[i] += s.v[i] * dt;
     });
-    // 5. Connection geometry at the new positions (of the connections of which i is the
-    // tip-side end; the others are recomputed identically), directions (3.15) and the blow-up
+    // 5. Connection geometry at the new positions, then directions (3.15) and the blow-up
     // check: first non-finite or too fast particle, in index order.
+    parallel_for(ctx, 0, np, [&](std::size_t q) { geometry_of(q, s, ws); });
     const double vlim = P.max_speed;
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
       LcpWorkspace::ChunkCheck c;
       for (std::size_t i = i0; i < i1; ++i) {
-        geometry_of(i, s, ws);
         direction_of(i, s, ws, true);
         const double sp = s.v[i].norm();
         const bool bad =

@@ -279,8 +279,8 @@ class LcpSolver {
   void hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws, const SphKernel& K,
                      double inv_w0) const;
   Vec3 gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const;
-  void geometry_of(std::size_t i, const LcpState& s, LcpWorkspace& ws) const;
-  void direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws, bool cached_rs) const;
+  void geometry_of(std::size_t q, const LcpState& s, LcpWorkspace& ws) const;
+  void direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws, bool cached) const;
   void density_of(std::size_t i, LcpWorkspace& ws, double w0) const;
   // Each particle's connections split by its role, in adjacency order, so the per-particle loops
   // run without a data-dependent branch per connection: m_rs_* lists the connections of which
