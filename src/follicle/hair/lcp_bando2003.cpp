@@ -417,21 +417,22 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
 // ---------------------------------------------------------------------------------------------
 // Dynamics
 //
-// Layout of a sub-step (step()): every loop runs over particles and writes only what that
-// particle owns: its own state, the connections of which it is the tip-side end (each connection
-// has exactly one), and the hair-hair pairs of its sorted neighbour list with a higher index. Per-
-// pair and per-connection values are then gathered in a fixed order, so results do not depend on
-// the thread count. Five parallel loops per sub-step:
-//   1. k_ij (3.7) + tethers, W(h, r) per pair and the compact list of interacting pairs,
-//      largest displacement since the list build
-//   2. alpha sums (3.13), density (3.1) and pressure
-//   3. alpha_ij (3.14), spring forces, hair-hair forces (3.16)-(3.18)
-//   4. gather of the forces, accelerations and the leapfrog update
-//   5. connection geometry at the new positions (stored by the tip-side end for the next
-//      sub-step, recomputed bit-identically by the root-side end), direction update (3.15)
-//      and the blow-up check
+// Layout of a sub-step (step()): every loop runs over particles or over connections and writes
+// only what its item owns: a particle's own state and the hair-hair pairs of its sorted
+// neighbour list with a higher index, or one connection's values. Per-pair and per-connection
+// values are then gathered in a fixed order, so results do not depend on the thread count. Six
+// parallel loops per sub-step:
+//   1. (particles) k_ij (3.7) + tethers of the connections of which the particle is the
+//      tip-side end, W(h, r) per pair and the compact list of interacting pairs, largest
+//      displacement since the list build
+//   2. (particles) alpha sums (3.13), density (3.1) and pressure
+//   3. (connections, then particles) alpha_ij (3.14) and the spring force per connection;
+//      hair-hair forces (3.16)-(3.18) per particle
+//   4. (particles) gather of the forces, accelerations and the leapfrog update
+//   5. (connections) geometry |x_ab|, x^_ab at the new positions
+//   6. (particles) direction update (3.15) from that geometry and the blow-up check
 // Each particle's connections are kept in two lists by its role (root-side / tip-side end), so
-// none of these loops branches per connection on which end it is.
+// none of the particle loops branches per connection on which end it is.
 
 namespace {
 // Particles (or connections) per task of the sub-step loops: small enough that two threads
