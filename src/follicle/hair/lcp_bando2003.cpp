@@ -639,23 +639,40 @@ void LcpSolver::rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWor
 }
 
 namespace {
-/// First entry of each sorted list with a neighbour index above the particle's own.
-void upper_starts(const Context& ctx, const std::vector<uint32_t>& off,
-                  const std::vector<uint32_t>& nb, std::vector<uint32_t>& upper) {
+/// For sorted and mirrored lists: the first entry of each list with a neighbour index above the
+/// particle's own (nbr_upper), the pair slots of each particle (pair_off) and the pair slot of
+/// every entry (nbr_pair).
+void pair_index(const Context& ctx, LcpWorkspace& ws) {
+  const auto& off = ws.nbr_offsets;
+  const auto& nb = ws.nbrs;
   const std::size_t n = off.empty() ? 0 : off.size() - 1;
+  auto& upper = ws.nbr_upper;
   upper.resize(n);
   parallel_for(ctx, 0, n, [&](std::size_t i) {
     upper[i] = uint32_t(
         std::upper_bound(nb.begin() + off[i], nb.begin() + off[i + 1], uint32_t(i)) - nb.begin());
   });
+  ws.pair_off.resize(n + 1);
+  ws.pair_off[0] = 0;
+  for (std::size_t i = 0; i < n; ++i) ws.pair_off[i + 1] = ws.pair_off[i] + (off[i + 1] - upper[i]);
+  ws.nbr_pair.resize(nb.size());
+  parallel_for(ctx, 0, n, [&](std::size_t i) {
+    // A lower entry's pair is the upper entry nbr_mirror[e] of particle j = nbrs[e].
+    for (uint32_t e = off[i]; e < upper[i]; ++e) {
+      const uint32_t j = nb[e];
+      ws.nbr_pair[e] = ws.pair_off[j] + (ws.nbr_mirror[e] - upper[j]);
+    }
+    for (uint32_t e = upper[i]; e < off[i + 1]; ++e)
+      ws.nbr_pair[e] = ws.pair_off[i] + (e - upper[i]);
+  });
 }
 }  // namespace
 
 void LcpSolver::pair_scratch(LcpWorkspace& ws) {
-  const std::size_t ne = ws.nbrs.size();
-  ws.pair_w.resize(ne);
-  ws.pair_f.resize(ne);
-  ws.pair_act.resize(ne);
+  const std::size_t npairs = ws.pair_off.empty() ? 0 : ws.pair_off.back();
+  ws.pair_w.resize(npairs);
+  ws.pair_f.resize(npairs);
+  ws.pair_act.resize(npairs);
   ws.act_end.resize(ws.nbr_offsets.empty() ? 0 : ws.nbr_offsets.size() - 1);
 }
 
@@ -664,8 +681,9 @@ void LcpSolver::density_of(std::size_t i, LcpWorkspace& ws, double w0) const {
   double rho = m.mass[i] * w0;
   // (3.1), in list order: pairs below nbr_upper[i] were evaluated by the other end.
   const uint32_t e0 = ws.nbr_offsets[i], eu = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
-  for (uint32_t e = e0; e < eu; ++e) rho += m.mass[ws.nbrs[e]] * ws.pair_w[ws.nbr_mirror[e]];
-  for (uint32_t e = eu; e < e1; ++e) rho += m.mass[ws.nbrs[e]] * ws.pair_w[e];
+  for (uint32_t e = e0; e < eu; ++e) rho += m.mass[ws.nbrs[e]] * ws.pair_w[ws.nbr_pair[e]];
+  const uint32_t p0 = ws.pair_off[i];  // pair slot of entry e >= eu: p0 + (e - eu)
+  for (uint32_t e = eu; e < e1; ++e) rho += m.mass[ws.nbrs[e]] * ws.pair_w[p0 + (e - eu)];
   ws.density[i] = rho;
   ws.pressure[i] = m_params.k_a * (rho - m_rho0);  // P = k_a (rho - rho0)
   ws.p_rho2[i] = ws.pressure[i] / (rho * rho);
@@ -676,7 +694,7 @@ void LcpSolver::pair_forces(const Context& ctx, const LcpState& s, LcpWorkspace&
   if (m_params.hair_hair && !ws.nbr_offsets.empty()) {
     if (!sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
       fail("lcp: pair_forces needs symmetric neighbour lists without self entries");
-    upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
+    pair_index(ctx, ws);
   }
   pair_forces_sorted(ctx, s, ws);
 }
@@ -702,20 +720,21 @@ void LcpSolver::spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, do
 void LcpSolver::active_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
                                 const SphKernel& K) const {
   // W(h, r) of every pair i < j of the list (0 beyond 2h) and the compact list of the pairs that
-  // interact (0 < r < 2h), stored from nbr_upper[i] on; pair_f of the others is zeroed. Without
-  // branches on the distance: with the Verlet skin about a third of the listed pairs lie beyond
-  // 2h, in no predictable order.
+  // interact (0 < r < 2h), stored in i's pair slots from pair_off[i] on; pair_f of the others is
+  // zeroed. Without branches on the distance: with the Verlet skin about a third of the listed
+  // pairs lie beyond 2h, in no predictable order.
   const double r2max = 4 * m_model.h * m_model.h;
   const Vec3 xi = s.x[i];
   const uint32_t e0 = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
-  // Interacting entries are listed from e0 upwards, the others from e1 downwards; both cursors
+  const uint32_t p0 = ws.pair_off[i], p1 = ws.pair_off[i + 1];
+  // Interacting entries are listed from p0 upwards, the others from p1 downwards; both cursors
   // write every entry into the free slots [lo, hi) and one of them advances.
-  uint32_t lo = e0, hi = e1;
+  uint32_t lo = p0, hi = p1;
   for (uint32_t e = e0; e < e1; ++e) {
     const double d2 = (s.x[ws.nbrs[e]] - xi).squaredNorm();
     const double w = K.w(std::sqrt(d2));
     const bool inside = d2 < r2max;
-    ws.pair_w[e] = inside ? w : 0.0;
+    ws.pair_w[p0 + (e - e0)] = inside ? w : 0.0;  // the pair slot of entry e
     const uint32_t act = (inside && d2 > 0) ? 1u : 0u;
     ws.pair_act[lo] = e;
     ws.pair_act[hi - 1] = e;
@@ -723,7 +742,7 @@ void LcpSolver::active_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& 
     hi -= 1u - act;
   }
   ws.act_end[i] = lo;
-  for (uint32_t k = lo; k < e1; ++k) ws.pair_f[ws.pair_act[k]] = Vec3::Zero();
+  for (uint32_t k = lo; k < p1; ++k) ws.pair_f[p0 + (ws.pair_act[k] - e0)] = Vec3::Zero();
 }
 
 void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
@@ -735,7 +754,8 @@ void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws
   const double eps2 = p.colinear_eps * p.colinear_eps;
   const Vec3 xi = s.x[i], vi = s.v[i], ti = s.t[i];
   const double mi = m.mass[i], pi = ws.p_rho2[i];
-  for (uint32_t k = ws.nbr_upper[i]; k < ws.act_end[i]; ++k) {
+  const uint32_t e0 = ws.nbr_upper[i], p0 = ws.pair_off[i];  // pair slot of e: p0 + (e - e0)
+  for (uint32_t k = p0; k < ws.act_end[i]; ++k) {
     const uint32_t e = ws.pair_act[k];
     const uint32_t j = ws.nbrs[e];
     const Vec3 xab = s.x[j] - xi;
@@ -771,7 +791,7 @@ void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws
       f += dc_on * muw * vn * dh;
       f += p.friction_damping * muw * (vab - vn * dh);  // (3.18) d_f W (v_ij . d^_t) d^_t
     }
-    ws.pair_f[e] = f;
+    ws.pair_f[p0 + (e - e0)] = f;
   }
 }
 
@@ -784,8 +804,9 @@ Vec3 LcpSolver::gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const 
   if (hh) {
     // The lists are sorted: entries below nbr_upper[i] are pairs evaluated by the other end.
     const uint32_t e0 = ws.nbr_offsets[i], eu = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
-    for (uint32_t e = e0; e < eu; ++e) f -= ws.pair_f[ws.nbr_mirror[e]];
-    for (uint32_t e = eu; e < e1; ++e) f += ws.pair_f[e];
+    for (uint32_t e = e0; e < eu; ++e) f -= ws.pair_f[ws.nbr_pair[e]];
+    const uint32_t p0 = ws.pair_off[i];  // pair slot of entry e >= eu: p0 + (e - eu)
+    for (uint32_t e = eu; e < e1; ++e) f += ws.pair_f[p0 + (e - eu)];
   }
   return f;
 }
@@ -803,7 +824,8 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
   });
   const bool hh = p.hair_hair && ws.nbr_offsets.size() == n + 1 && ws.density.size() == n &&
                   ws.pressure.size() == n && ws.nbr_mirror.size() == ws.nbrs.size() &&
-                  ws.nbr_upper.size() == n;
+                  ws.nbr_upper.size() == n && ws.pair_off.size() == n + 1 &&
+                  ws.nbr_pair.size() == ws.nbrs.size();
   if (hh) {
     ws.p_rho2.resize(n);
     for (std::size_t i = 0; i < n; ++i)
@@ -974,8 +996,9 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       rebuild = skin <= 0 || ws.nbr_built_x.size() != n || ws.nbr_radius != Rn ||
                 ws.nbr_offsets.size() != n + 1 || ws.nbr_mirror.size() != ws.nbrs.size();
       if (rebuild) rebuild_neighbours(ctx, s, ws);
-      if (rebuild || ws.nbr_upper.size() != n)
-        upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
+      if (rebuild || ws.nbr_upper.size() != n || ws.pair_off.size() != n + 1 ||
+          ws.nbr_pair.size() != ws.nbrs.size())
+        pair_index(ctx, ws);
       pair_scratch(ws);
     }
     for (int attempt = 0; attempt < 2; ++attempt) {
@@ -997,7 +1020,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       // Some particle moved more than half the skin: rebuild and redo (also when NaN).
       rebuild = true;
       rebuild_neighbours(ctx, s, ws);
-      upper_starts(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_upper);
+      pair_index(ctx, ws);
       pair_scratch(ws);
     }
     // 2. alpha sums (3.13), density (3.1) and pressure.

@@ -177,10 +177,14 @@ struct LcpWorkspace {
   std::vector<Vec3> nbr_built_x;     // positions at the last list build
   double nbr_radius = 0;             // radius of the last build [m]
   std::size_t nbr_builds = 0;        // number of list builds (statistics)
-  std::vector<double> pair_w;        // W(h, r) per entry with i < j
-  std::vector<Vec3> pair_f;          // hair-hair force on i per entry with i < j [N]
-  // Entries (i < j) with 0 < r < 2h, compacted per particle into [nbr_upper[i], act_end[i]);
-  // the other entries of the upper list follow, up to nbr_offsets[i + 1].
+  // Pairs i < j (the entries of each list from nbr_upper[i] on) are numbered in list order:
+  // particle i's pairs are the slots pair_off[i] .. pair_off[i + 1] - 1, and nbr_pair[e] is the
+  // slot of the pair of entry e (of either end), so the per-pair arrays hold each pair once.
+  std::vector<uint32_t> pair_off, nbr_pair;
+  std::vector<double> pair_w;  // W(h, r) per pair slot
+  std::vector<Vec3> pair_f;    // hair-hair force on the lower-index end per pair slot [N]
+  // The list entries of particle i's pairs with 0 < r < 2h, compacted into the slots
+  // [pair_off[i], act_end[i]); the other entries of its pairs follow, up to pair_off[i + 1].
   std::vector<uint32_t> pair_act, act_end;
   std::vector<Vec3> spring_f;       // spring force on the root-side end per connection [N]
   std::vector<double> p_rho2;       // P_i / rho_i^2 per particle
