@@ -1,7 +1,6 @@
 #include "follicle/hair/particle_grid.hpp"
 
 #include <algorithm>
-#include <atomic>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -330,8 +329,9 @@ bool sort_then_match(const Context& ctx, const std::vector<uint32_t>& offsets,
 /// Transposes the CSR lists `in` into `out` (same offsets): row j of out gets every i with j in
 /// row i of in, by increasing i. When `pos` is given, pos[e] receives the slot of out that entry
 /// e of in went to; with `expect`, every slot must already hold the i that goes there. Returns
-/// false when a row of out would overflow, an index is >= n or `expect` differs (then the lists
-/// are not symmetric). Serial: one pass over the entries; two threads each scanning all entries
+/// false when a row of out would overflow, an index is >= n, a row holds its own index (a self
+/// entry: no pair, though it is its own transpose) or `expect` differs (then the lists are not
+/// symmetric pair lists). Serial: one pass over the entries; two threads each scanning all entries
 /// for half of the rows measured slower (memory bound).
 bool transpose(const std::vector<uint32_t>& offsets, const uint32_t* in, uint32_t* out,
                uint32_t* pos, const uint32_t* expect) {
@@ -340,7 +340,7 @@ bool transpose(const std::vector<uint32_t>& offsets, const uint32_t* in, uint32_
   for (std::size_t i = 0; i < n; ++i)
     for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
       const uint32_t j = in[e];
-      if (j >= n) return false;  // index beyond the particles
+      if (j >= n || j == i) return false;  // index beyond the particles, or a self entry
       const uint32_t c = cursor[j]++;
       if (c >= offsets[j + 1] || (expect && expect[c] != i)) return false;
       if (out) out[c] = uint32_t(i);
@@ -356,8 +356,8 @@ bool sort_and_mirror(const Context& ctx, const std::vector<uint32_t>& offsets,
   // holds the i with j in list i, by increasing i), and transposing T once more pairs the k-th
   // entry i of row j with the k-th entry j of row i, which is the pairing of the cursor
   // algorithm. T is accepted only when it equals its own transpose; then the lists equal T as
-  // multisets, so the result is exactly sort_then_match's. Otherwise (asymmetric lists) the
-  // lists are restored and sort_then_match gives the rejection.
+  // multisets, so the result is exactly sort_then_match's. Otherwise (asymmetric lists, self
+  // entries) the lists are restored and sort_then_match gives the rejection.
   const std::size_t n = offsets.empty() ? 0 : offsets.size() - 1;
   if (n == 0 || offsets[n] != nbrs.size() || offsets[0] != 0)
     return sort_then_match(ctx, offsets, nbrs, mirror);
@@ -371,20 +371,6 @@ bool sort_and_mirror(const Context& ctx, const std::vector<uint32_t>& offsets,
     return sort_then_match(ctx, offsets, nbrs, mirror);
   }
   nbrs.swap(mirror);
-  // A self entry (i in list i) is its own transpose, so it passes the symmetry check; it is no
-  // pair and is rejected like an asymmetric list.
-  std::atomic<bool> self{false};
-  parallel_for(
-      ctx, 0, n,
-      [&](std::size_t i) {
-        for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e)
-          if (nbrs[e] == i) self.store(true, std::memory_order_relaxed);
-      },
-      4096);
-  if (self.load()) {
-    mirror.clear();
-    return false;
-  }
   return true;
 }
 
