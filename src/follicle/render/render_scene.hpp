@@ -201,6 +201,10 @@ struct RenderSettings {
   /// this many equal batches; each batch reads the light reaching it, then is splatted.
   /// >= the particle count reproduces the paper's per-particle read exactly.
   int hair_light_slices = 128;
+  /// Hair view pass (Bando 2003 §3.4 lines 17-21): "cpu" blends the billboards into the
+  /// read-back colour buffer on the CPU (docs/adr/0007-cpu-splat-view-pass.md; several times
+  /// faster than a software GL rasteriser), "gpu" draws them with GL.
+  std::string hair_view_pass = "cpu";
 
   template <class V>
   void visit(V&& v) {
@@ -215,14 +219,18 @@ struct RenderSettings {
       ParamInfo{"hair light-view pass: \"cpu\" (exact per particle) or \"gpu\" (depth slices)"});
     v("hair_light_slices", hair_light_slices,
       ParamInfo{"depth slices of the \"gpu\" hair light-view pass", "", 1, 1 << 24});
+    v("hair_view_pass", hair_view_pass,
+      ParamInfo{"hair view pass: \"cpu\" (billboards blended on the CPU) or \"gpu\" (GL)"});
   }
   void validate() const {
     validate_params(*this, "render");
     if (const std::string e = hair_light_pass_error(hair_light_pass); !e.empty())
       fail_at("render.hair_light_pass", "{}", e);
+    if (const std::string e = hair_light_pass_error(hair_view_pass); !e.empty())
+      fail_at("render.hair_view_pass", "{}", e);
   }
-  /// Empty when `v` names a hair light-view pass, else what is wrong with it (shared by the
-  /// scene reader, which reports it at the JSON path).
+  /// Empty when `v` names a hair light-view or view pass ("cpu" or "gpu"), else what is wrong
+  /// with it (shared by the scene reader, which reports it at the JSON path).
   static std::string hair_light_pass_error(const std::string& v) {
     if (v == "cpu" || v == "gpu") return {};
     return "unknown value \"" + v + "\"; expected \"cpu\" or \"gpu\"";

@@ -6,6 +6,7 @@
 #include <GL/gl.h>
 #include <GL/glext.h>
 #include <spdlog/spdlog.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "follicle/render/egl_context.hpp"
 #include "follicle/render/gl_util.hpp"
 #include "follicle/render/renderer.hpp"
+#include "follicle/render/resolve_cpu.hpp"
 #include "follicle/render/shaders_gl.hpp"
 #include "follicle/render/splat_gl.hpp"
 
@@ -198,7 +200,9 @@ std::vector<MeshVertex> build_mesh_vertices(const MeshItem& item, std::size_t in
 class GlRenderer final : public Renderer {
  public:
   GlRenderer(const Context& ctx, std::unique_ptr<EglContext> egl)
-      : m_log(ctx.logger_ptr()), m_egl(std::move(egl)) {
+      : m_log(ctx.logger_ptr()),
+        m_arena(std::make_unique<tbb::task_arena>(ctx.threads())),
+        m_egl(std::move(egl)) {
     if (m_egl) m_egl->make_current();
     init();
   }
@@ -224,8 +228,15 @@ class GlRenderer final : public Renderer {
 
   image::ImageRGBA8 render(const RenderScene& scene, const RenderSettings& settings) override {
     if (m_egl) m_egl->make_current();
-    draw(scene, settings);
     image::ImageRGBA8 img(settings.width, settings.height);
+    if (draw(scene, settings, &m_cpu_frame)) {
+      // The frame came back for the CPU hair view pass: resolve it here too.
+      m_arena->execute([&] {
+        resolve_srgb_cpu(m_cpu_frame.data(), m_fb_w, m_fb_h, settings.supersample,
+                         settings.transparent_background, img);
+      });
+      return img;
+    }
     glBindFramebuffer(GL_READ_FRAMEBUFFER, m_out_fbo);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, settings.width, settings.height, GL_RGBA, GL_UNSIGNED_BYTE, img.data());
@@ -425,7 +436,11 @@ class GlRenderer final : public Renderer {
     set_vec3(p, "uEye", scene.camera.eye);
   }
 
-  void draw(const RenderScene& scene, const RenderSettings& settings) {
+  /// Draws the frame. With `cpu_frame` and a CPU hair view pass, the colour buffer is read back
+  /// into it before the hair is drawn there, and the GL resolve is skipped: returns true, the
+  /// caller resolves *cpu_frame. Otherwise the result is in m_out_fbo and it returns false.
+  bool draw(const RenderScene& scene, const RenderSettings& settings,
+            std::vector<float>* cpu_frame = nullptr) {
     settings.validate();
     scene.camera.validate();
     if (scene.lights.size() > std::size_t(kMaxLights))
@@ -591,7 +606,18 @@ class GlRenderer final : public Renderer {
       }
       check_gl("particle pass");
     }
-    if (!m_splat->empty()) m_splat->view_pass(scene, view, view_proj, m_empty_vao);
+    if (!m_splat->empty()) {
+      if (settings.hair_view_pass == "gpu")
+        m_splat->view_pass(scene, view, view_proj, m_empty_vao);
+      else if (cpu_frame) {
+        m_splat->view_pass_cpu(scene, view, view_proj, m_color_tex, m_fb_w, m_fb_h, *m_arena,
+                               cpu_frame);
+        glBindVertexArray(0);
+        return true;
+      } else {
+        m_splat->view_pass_cpu(scene, view, view_proj, m_color_tex, m_fb_w, m_fb_h, *m_arena);
+      }
+    }
 
     // ---- resolve ------------------------------------------------------------------------------
     glDisable(GL_DEPTH_TEST);
@@ -608,6 +634,7 @@ class GlRenderer final : public Renderer {
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     check_gl("resolve");
+    return false;
   }
 
   struct MeshPassState {
@@ -864,6 +891,8 @@ class GlRenderer final : public Renderer {
   };
 
   std::shared_ptr<spdlog::logger> m_log;
+  std::unique_ptr<tbb::task_arena> m_arena;  // the CPU hair view pass's threads (ctx.threads())
+  std::vector<float> m_cpu_frame;            // the frame read back for the CPU view pass
   std::unique_ptr<EglContext> m_egl;
   std::string m_description;
   std::map<int, GLuint> m_mesh_progs;

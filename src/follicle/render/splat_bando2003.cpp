@@ -37,6 +37,19 @@ Vec3 kajiya_goldman(const Vec3& t, const Vec3& to_light, const Vec3& to_eye, con
   return fdir * (m.diffuse * sl * colour + Vec3::Constant(m.specular * spec));
 }
 
+void splat_billboard_axes(const Vec3& t, const Vec3& d_p, double min_sin, Vec3& along, Vec3& across,
+                          double& s) {
+  Vec3 tp = t - t.dot(d_p) * d_p;
+  double st = tp.norm();
+  if (st < 1e-6) {
+    tp = d_p.cross(std::abs(d_p.x()) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
+    st = 0;
+  }
+  along = tp.normalized();
+  across = d_p.cross(along).normalized();
+  s = std::max(st, min_sin);
+}
+
 double splat_sin_theta(const Vec3& t, const Vec3& d_p, double min_sin) {
   const double c = std::clamp(t.normalized().dot(d_p.normalized()), -1.0, 1.0);
   return std::max(std::sqrt(1 - c * c), min_sin);

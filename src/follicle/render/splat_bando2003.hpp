@@ -30,6 +30,13 @@ double goldman_directionality(const Vec3& t, const Vec3& to_light, const Vec3& t
 Vec3 kajiya_goldman(const Vec3& t, const Vec3& to_light, const Vec3& to_eye, const Vec3& colour,
                     const SplatMaterial& m);
 
+/// The billboard frame of Fig. 3.5(b) (billboard_axes() of kSplatCommon): the billboard lies
+/// across the projection direction d_p (unit) with its vertical axis `along` the projection of
+/// t; `across` = d_p x along; s = max(sin(theta), min_sin) with cos(theta) = t . d_p. When t is
+/// parallel to d_p the axes are an arbitrary frame across d_p and s = min_sin.
+void splat_billboard_axes(const Vec3& t, const Vec3& d_p, double min_sin, Vec3& along, Vec3& across,
+                          double& s);
+
 /// Effective sin(theta) of a billboard, cos(theta) = t . d_p, clamped below by min_sin
 /// (the billboard is drawn `sin_eff` times its length along the projected t).
 double splat_sin_theta(const Vec3& t, const Vec3& d_p, double min_sin);

@@ -17,6 +17,8 @@
 //   framebuffer switch that flushes llvmpipe's rasteriser.
 #include "follicle/render/splat_gl.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -98,6 +100,7 @@ SplatPassGl::SplatPassGl() {
   const image::ImageRGBA8 hair = make_hair_texture();
   m_default_tex = upload_hair_texture(hair);
   m_cpu_default_tex = std::make_unique<SplatAlphaTexture>(hair);
+  m_cpu_default_color = std::make_unique<SplatColorTexture>(hair);
   check_gl("hair splat initialisation");
 }
 
@@ -243,6 +246,15 @@ const SplatAlphaTexture& SplatPassGl::cpu_hair_texture() {
   return *m_cpu_custom_tex;
 }
 
+const SplatColorTexture& SplatPassGl::cpu_hair_color_texture() {
+  if (!m_custom_tex_src) return *m_cpu_default_color;
+  if (!m_cpu_custom_color || m_cpu_custom_color_src != m_custom_tex_src) {
+    m_cpu_custom_color = std::make_unique<SplatColorTexture>(*m_custom_tex_src);
+    m_cpu_custom_color_src = m_custom_tex_src;
+  }
+  return *m_cpu_custom_color;
+}
+
 void SplatPassGl::ensure_intensity(std::size_t n) {
   const int w = int(std::min<std::size_t>(n, kIntensityWidth));
   const int h = int((n + kIntensityWidth - 1) / kIntensityWidth);
@@ -284,6 +296,7 @@ void SplatPassGl::bind_common(GLuint prog, int order_base) {
 
 void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao) {
   m_light_done = false;
+  m_intensity.clear();
   if (m_count == 0) return;
   settings.validate();
   const std::size_t n = m_count;
@@ -376,6 +389,7 @@ void SplatPassGl::light_exact_cpu(const Light& light) {
   // The view pass reads (visibility, light through the hair) per particle (line 20), the
   // meshes the light map (line 16).
   for (std::size_t i = 0; i < n; ++i) m_staging[2 * i + 1] = m_cpu_result.reach[i];
+  m_intensity.assign(m_staging.begin(), m_staging.begin() + std::ptrdiff_t(2 * n));
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glActiveTexture(GL_TEXTURE0 + kUnitIntensity);
   glBindTexture(GL_TEXTURE_2D, m_intensity_tex);
@@ -490,6 +504,106 @@ void SplatPassGl::view_pass(const RenderScene& scene, const Mat4& view, const Ma
   glDisable(GL_BLEND);
   glDepthMask(GL_TRUE);
   check_gl("hair view pass");
+}
+
+void SplatPassGl::view_pass_cpu(const RenderScene& scene, const Mat4& view, const Mat4& view_proj,
+                                GLuint color_tex, int fb_w, int fb_h, tbb::task_arena& arena,
+                                std::vector<float>* frame) {
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  if (frame) {  // the whole colour buffer, with or without hair on it
+    frame->resize(4 * std::size_t(fb_w) * std::size_t(fb_h));
+    glReadPixels(0, 0, fb_w, fb_h, GL_RGBA, GL_FLOAT, frame->data());
+    check_gl("frame read-back");
+  }
+  if (m_count == 0) return;
+  const std::size_t n = m_count;
+  if (m_light_done && m_intensity.empty()) {  // the "gpu" light pass: read its intensities
+    const int w = m_intensity_w;
+    const int rows = int((n + std::size_t(w) - 1) / std::size_t(w));
+    m_staging.assign(2 * std::size_t(w) * std::size_t(rows), 0.0f);
+    GLint prev = 0;
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &prev);
+    glBindFramebuffer(GL_FRAMEBUFFER, m_intensity_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, rows, GL_RG, GL_FLOAT, m_staging.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, GLuint(prev));
+    m_intensity.assign(m_staging.begin(), m_staging.begin() + std::ptrdiff_t(2 * n));
+  }
+  // Line 20's colour, per particle as kSplatViewVs computes it.
+  const int nl = int(std::min<std::size_t>(scene.lights.size(), kMaxLights));
+  int shadow_light = -1;
+  for (int i = 0; i < nl && m_light_done; ++i)
+    if (scene.lights[std::size_t(i)].cast_shadow) {
+      shadow_light = i;
+      break;
+    }
+  const Vec3 eye = scene.camera.eye;
+  m_view_particles.resize(n);
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), n, std::size_t(256), [&](std::size_t b) {
+      const std::size_t e = std::min(n, b + 256);
+      for (std::size_t i = b; i < e; ++i) {
+        const float* r = &m_data[16 * i];
+        ViewSplatParticle& p = m_view_particles[i];
+        p.pos = Vec3(r[0], r[1], r[2]);
+        p.half_w = r[3];
+        p.t = Vec3(r[4], r[5], r[6]);
+        p.half_l = r[7];
+        p.alpha = r[11];
+        p.min_sin = r[12];
+        const Vec3 c(r[8], r[9], r[10]);
+        const SplatMaterial& m = m_items[std::size_t(r[15] + 0.5f)].item->splat;
+        const Vec3 to_eye = (eye - p.pos).normalized();
+        double att = 1;
+        if (m_light_done) att = m_intensity[2 * i] * (r[14] > 0.5f ? m_intensity[2 * i + 1] : 1.0f);
+        Vec3 col = c.cwiseProduct(m.ambient * scene.ambient_color);
+        for (int j = 0; j < nl; ++j) {
+          const DirectionalLight& l = scene.lights[std::size_t(j)];
+          const Vec3 ej = l.color * l.intensity * (j == shadow_light ? att : 1.0);
+          col += ej.cwiseProduct(kajiya_goldman(p.t, -l.direction.normalized(), to_eye, c, m));
+        }
+        p.color = nl == 0 ? c : col;  // no lights: unlit hair colour
+      }
+    });
+  });
+  SplatViewParams prm;
+  prm.view_proj = view_proj;
+  prm.eye = eye;
+  int box[4];
+  splat_view_bounds(prm, m_view_particles, fb_w, fb_h, box);
+  if (box[0] >= box[2]) return;  // nothing on screen
+  SplatViewTarget tg;
+  tg.fb_width = fb_w;
+  tg.fb_height = fb_h;
+  tg.x0 = box[0];
+  tg.y0 = box[1];
+  tg.width = box[2] - box[0];
+  tg.height = box[3] - box[1];
+  const std::size_t npix = std::size_t(tg.width) * std::size_t(tg.height);
+  m_view_depth.resize(npix);
+  // Line 17: the objects' depth (and the colour under the hair) of the billboards' rectangle.
+  if (frame) {
+    tg.rgba = frame->data() + 4 * (std::size_t(tg.y0) * std::size_t(fb_w) + std::size_t(tg.x0));
+    tg.rgba_stride = fb_w;
+  } else {
+    m_view_rgba.resize(4 * npix);
+    glReadPixels(tg.x0, tg.y0, tg.width, tg.height, GL_RGBA, GL_FLOAT, m_view_rgba.data());
+    tg.rgba = m_view_rgba.data();
+  }
+  glReadPixels(tg.x0, tg.y0, tg.width, tg.height, GL_DEPTH_COMPONENT, GL_FLOAT,
+               m_view_depth.data());
+  check_gl("hair view pass read-back");
+  tg.depth = m_view_depth.data();
+  // Line 18: far first.
+  const std::vector<int32_t> order = splat_view_order(view, m_view_particles);
+  const SplatColorTexture& tex = cpu_hair_color_texture();
+  arena.execute([&] { splat_view_pass_bando2003(prm, m_view_particles, order, tex, tg); });
+  if (frame) return;
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glBindTexture(GL_TEXTURE_2D, color_tex);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, tg.x0, tg.y0, tg.width, tg.height, GL_RGBA, GL_FLOAT,
+                  m_view_rgba.data());
+  check_gl("hair view pass upload");
 }
 
 }  // namespace follicle::render

@@ -9,10 +9,16 @@
 //                 draw read back once, then splat_light_bando2003() exactly per particle on
 //                 the CPU, uploaded as the light map and the per-particle intensities;
 //                 "gpu": in `hair_light_slices` depth slices on the GPU;
-//   view_pass()   lines 17-21: back-to-front textured billboards, Kajiya-Kay x Goldman.
-// See docs/adr/0005-cpu-splat-light-pass.md and docs/adr/0003-splat-light-pass.md.
+//   view_pass()   lines 17-21: back-to-front textured billboards, Kajiya-Kay x Goldman, drawn
+//                 with GL ("gpu");
+//   view_pass_cpu() the same on the CPU (default "cpu"): the particles shaded per particle as
+//                 in kSplatViewVs, the colour and depth of the billboards' screen rectangle read
+//                 back, splat_view_bando2003() blends them, the rectangle goes back up.
+// See docs/adr/0005-cpu-splat-light-pass.md, docs/adr/0003-splat-light-pass.md and
+// docs/adr/0007-cpu-splat-view-pass.md.
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Geometry>
 #include <memory>
@@ -20,6 +26,7 @@
 
 #include "follicle/render/render_scene.hpp"
 #include "follicle/render/splat_light_bando2003.hpp"
+#include "follicle/render/splat_view_bando2003.hpp"
 
 namespace follicle::render {
 
@@ -53,10 +60,19 @@ class SplatPassGl {
   /// Lines 17-21 into the bound framebuffer (depth test on, depth writes off while drawing).
   void view_pass(const RenderScene& scene, const Mat4& view, const Mat4& view_proj,
                  GLuint empty_vao);
+  /// Lines 17-21 on the CPU for the bound framebuffer, whose colour attachment is `color_tex`
+  /// (RGBA16F, fb_w x fb_h) with a depth attachment; runs its threads in `arena`. Without
+  /// `frame` the billboards' rectangle is read back, drawn and uploaded again; with it the
+  /// whole colour buffer is read into *frame (fb_w x fb_h RGBA floats, rows bottom up), drawn
+  /// there and not uploaded (the caller resolves it on the CPU).
+  void view_pass_cpu(const RenderScene& scene, const Mat4& view, const Mat4& view_proj,
+                     GLuint color_tex, int fb_w, int fb_h, tbb::task_arena& arena,
+                     std::vector<float>* frame = nullptr);
 
  private:
   GLuint hair_texture();
   const SplatAlphaTexture& cpu_hair_texture();
+  const SplatColorTexture& cpu_hair_color_texture();
   void light_slices_gpu(const Light& light, std::size_t slices);
   void light_exact_cpu(const Light& light);
   void ensure_intensity(std::size_t n);
@@ -91,6 +107,13 @@ class SplatPassGl {
   std::shared_ptr<const image::ImageRGBA8> m_cpu_custom_src;
   SplatLightResult m_cpu_result;
   std::vector<float> m_staging;
+  // The "cpu" view pass: the hair texture's RGBA mip chains, the particles, the per-particle
+  // (visibility, light through the hair) of the light pass and the read-back window.
+  std::unique_ptr<SplatColorTexture> m_cpu_default_color, m_cpu_custom_color;
+  std::shared_ptr<const image::ImageRGBA8> m_cpu_custom_color_src;
+  std::vector<ViewSplatParticle> m_view_particles;
+  std::vector<float> m_intensity;  // 2 per particle, valid when m_light_done
+  std::vector<float> m_view_rgba, m_view_depth;
 };
 
 }  // namespace follicle::render

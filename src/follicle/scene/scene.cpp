@@ -34,6 +34,9 @@ void Scene::validate(const JsonSource& src) const {
   if (const std::string e = render::RenderSettings::hair_light_pass_error(render.hair_light_pass);
       !e.empty())
     json_fail(src, "render.hair_light_pass", e);
+  if (const std::string e = render::RenderSettings::hair_light_pass_error(render.hair_view_pass);
+      !e.empty())
+    json_fail(src, "render.hair_view_pass", e);
   std::set<std::string> names;
   for (std::size_t i = 0; i < assets.meshes.size(); ++i) {
     const auto& m = assets.meshes[i];

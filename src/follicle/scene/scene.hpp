@@ -150,6 +150,7 @@ struct RenderSpec {
   Vec3 ambient_color{1, 1, 1};
   int shadow_map_size = 2048;
   std::string hair_light_pass = "cpu";  // render::RenderSettings::hair_light_pass
+  std::string hair_view_pass = "cpu";   // render::RenderSettings::hair_view_pass
 
   template <class V>
   void visit(V&& v) {
@@ -164,6 +165,9 @@ struct RenderSpec {
     v("hair_light_pass", hair_light_pass,
       ParamInfo{"hair splat light pass (Bando 2003 §3.4): \"cpu\" exact per particle, or "
                 "\"gpu\" in depth slices"});
+    v("hair_view_pass", hair_view_pass,
+      ParamInfo{"hair splat view pass (Bando 2003 §3.4): \"cpu\" billboards blended on the "
+                "CPU (fast on a software rasteriser), or \"gpu\" drawn with GL"});
   }
 };
 

@@ -1,0 +1,77 @@
+// CPU resolve pass; see resolve_cpu.hpp.
+#include "follicle/render/resolve_cpu.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "follicle/core/error.hpp"
+
+namespace follicle::render {
+namespace {
+
+constexpr int kTable = 4096;  // intervals of the sRGB table over [0, 1]
+
+/// [0, 1] (NaN -> 0, like GL's clamp of a NaN in practice).
+float unit(float v) {
+  return v > 0 ? std::min(v, 1.0f) : 0.0f;
+}
+
+/// Round to nearest of v in [0, 1] x 255 (GL's float -> unorm8 conversion).
+uint8_t unorm8(float v) {
+  return uint8_t(int(unit(v) * 255.0f + 0.5f));
+}
+
+}  // namespace
+
+double srgb_encode(double c) {
+  c = std::clamp(c, 0.0, 1.0);
+  return c < 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+}
+
+void resolve_srgb_cpu(const float* rgba, int fb_w, int fb_h, int k, bool unpremultiply,
+                      image::ImageRGBA8& out) {
+  if (k < 1) fail("resolve: supersampling factor {} is not >= 1", k);
+  if (!rgba || out.empty() || fb_w != k * out.width() || fb_h != k * out.height())
+    fail("resolve: a {}x{} frame does not resolve {}x down to {}x{}", fb_w, fb_h, k, out.width(),
+         out.height());
+  // sRGB kTable + 1 evenly spaced linear values (the curve's linear toe ends
+  // at 0.0031308, inside the first 13 intervals, where interpolation is exact).
+  std::array<float, kTable + 2> table{};
+  for (int i = 0; i <= kTable; ++i) table[std::size_t(i)] = float(srgb_encode(double(i) / kTable));
+  table[kTable + 1] = table[kTable];
+  const int w = out.width(), h = out.height();
+  const float inv_n = 1.0f / float(k * k);
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y != r.end(); ++y) {
+      uint8_t* dst = out.data() + std::size_t(h - 1 - y) * std::size_t(w) * 4;  // flip rows
+      for (int x = 0; x < w; ++x) {
+        float s[4] = {0, 0, 0, 0};
+        for (int j = 0; j < k; ++j) {
+          const float* src =
+              rgba +
+              (std::size_t(y * k + j) * std::size_t(fb_w) + std::size_t(x) * std::size_t(k)) * 4;
+          for (int i = 0; i < k; ++i)
+            for (int c = 0; c < 4; ++c) s[c] += src[4 * i + c];
+        }
+        for (float& v : s) v *= inv_n;
+        for (int c = 0; c < 3; ++c) {
+          float v = s[c];
+          if (unpremultiply) v = s[3] > 0 ? v / s[3] : 0.0f;
+          const float t = unit(v) * float(kTable);
+          const int i = int(t);
+          const float e = table[std::size_t(i)] +
+                          (t - float(i)) * (table[std::size_t(i) + 1] - table[std::size_t(i)]);
+          dst[4 * x + c] = unorm8(e);
+        }
+        dst[4 * x + 3] = unorm8(s[3]);
+      }
+    }
+  });
+}
+
+}  // namespace follicle::render

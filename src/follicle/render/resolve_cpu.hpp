@@ -1,0 +1,20 @@
+#pragma once
+// The GL renderer's resolve pass (kResolveFs in shaders_gl.hpp) on the CPU, for frames whose
+// colour buffer is on the CPU anyway (the "cpu" hair view pass, docs/adr/0007): box filter of
+// k x k linear samples, optional unpremultiply, clamp to [0, 1], sRGB encode, 8-bit rounding.
+// The sRGB curve comes from a 4,097-entry table with linear interpolation (error below 0.005
+// of an 8-bit step, see the test); rows are resolved in parallel in the calling task arena.
+#include "follicle/image/image.hpp"
+
+namespace follicle::render {
+
+/// `rgba`: fb_w x fb_h linear RGBA floats, rows bottom-up (glReadPixels order), with
+/// fb_w = k * out.width() and fb_h = k * out.height() of the already sized `out`; `out` rows are
+/// top-down. Throws follicle::Error for a size mismatch or k < 1.
+void resolve_srgb_cpu(const float* rgba, int fb_w, int fb_h, int k, bool unpremultiply,
+                      image::ImageRGBA8& out);
+
+/// The exact sRGB encoding of a linear value in [0, 1] (IEC 61966-2-1), for tests and the table.
+double srgb_encode(double linear);
+
+}  // namespace follicle::render
