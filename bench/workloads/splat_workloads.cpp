@@ -1,6 +1,7 @@
 // Hair splat rendering (Bando 2003 §3.4): "lcp-render" renders the synthetic sphere head with
 // 2,000 hair particles, self-shadowing on (light-view pass, shadow map, light map), headless.
-// The light pass is the exact per-particle CPU pass (ADR 0005) unless gpu_light_pass=1.
+// The light pass is the exact per-particle CPU pass (ADR 0005) unless gpu_light_pass=1; the
+// view pass and the resolve run on the CPU (ADR 0007) unless gpu_view_pass=1.
 #include "follicle/render/renderer.hpp"
 #include "follicle/render/splat_bando2003.hpp"
 #include "workloads/workload.hpp"
@@ -18,6 +19,7 @@ class LcpRender final : public WorkloadInstance {
     m_settings.hair_light_map_size = int(sz.at("light_map_size"));
     m_settings.hair_light_pass = sz.at("gpu_light_pass") != 0 ? "gpu" : "cpu";
     m_settings.hair_light_slices = int(sz.at("slices"));  // the "gpu" pass only
+    m_settings.hair_view_pass = sz.at("gpu_view_pass") != 0 ? "gpu" : "cpu";
     m_settings.validate();
     m_scene = render::make_hair_sheet_scene(int(sz.at("particles")));
     m_scene.particles.at(0).splat.self_shadow = sz.at("self_shadow") != 0;
@@ -48,6 +50,7 @@ void add_splat_workloads(std::vector<Workload>& out) {
        {"light_map_size", 512},
        {"gpu_light_pass", 0},  // 1: the sliced GPU light pass (ADR 0003) instead of the CPU one
        {"slices", 128},
+       {"gpu_view_pass", 0},  // 1: the GL view pass and resolve instead of the CPU ones
        {"self_shadow", 1}},
       "frames/s",
       [](const Context& ctx, const Sizes& sz) -> std::unique_ptr<WorkloadInstance> {

@@ -556,7 +556,7 @@ class GlRenderer final : public Renderer {
         sl.shadow_tex = m_shadow_tex;
         sl.shadow_texel = 1.0 / settings.shadow_map_size;
         sl.shadow_bias = 2.0 * shadow_texel_world / shadow_depth_range;
-        m_splat->light_pass(sl, settings, m_empty_vao);
+        m_splat->light_pass(sl, settings, m_empty_vao, *m_arena);
       }
     }
 

@@ -46,29 +46,38 @@ void resolve_srgb_cpu(const float* rgba, int fb_w, int fb_h, int k, bool unpremu
   table[kTable + 1] = table[kTable];
   const int w = out.width(), h = out.height();
   const float inv_n = 1.0f / float(k * k);
+  // One output pixel from its averaged linear RGBA.
+  auto encode = [&](const float* s, uint8_t* d) {
+    for (int c = 0; c < 3; ++c) {
+      float v = s[c];
+      if (unpremultiply) v = s[3] > 0 ? v / s[3] : 0.0f;
+      const float t = unit(v) * float(kTable);
+      const int i = int(t);
+      const float e = table[std::size_t(i)] +
+                      (t - float(i)) * (table[std::size_t(i) + 1] - table[std::size_t(i)]);
+      d[c] = unorm8(e);
+    }
+    d[3] = unorm8(s[3]);
+  };
   tbb::parallel_for(tbb::blocked_range<int>(0, h, 8), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y != r.end(); ++y) {
       uint8_t* dst = out.data() + std::size_t(h - 1 - y) * std::size_t(w) * 4;  // flip rows
+      if (k == 1) {
+        const float* src = rgba + std::size_t(y) * std::size_t(fb_w) * 4;
+        for (int x = 0; x < w; ++x) encode(src + 4 * x, dst + 4 * x);
+        continue;
+      }
       for (int x = 0; x < w; ++x) {
-        float s[4] = {0, 0, 0, 0};
+        float s4[4] = {0, 0, 0, 0};
         for (int j = 0; j < k; ++j) {
           const float* src =
               rgba +
               (std::size_t(y * k + j) * std::size_t(fb_w) + std::size_t(x) * std::size_t(k)) * 4;
           for (int i = 0; i < k; ++i)
-            for (int c = 0; c < 4; ++c) s[c] += src[4 * i + c];
+            for (int c = 0; c < 4; ++c) s4[c] += src[4 * i + c];
         }
-        for (float& v : s) v *= inv_n;
-        for (int c = 0; c < 3; ++c) {
-          float v = s[c];
-          if (unpremultiply) v = s[3] > 0 ? v / s[3] : 0.0f;
-          const float t = unit(v) * float(kTable);
-          const int i = int(t);
-          const float e = table[std::size_t(i)] +
-                          (t - float(i)) * (table[std::size_t(i) + 1] - table[std::size_t(i)]);
-          dst[4 * x + c] = unorm8(e);
-        }
-        dst[4 * x + 3] = unorm8(s[3]);
+        for (float& v : s4) v *= inv_n;
+        encode(s4, dst + 4 * x);
       }
     }
   });

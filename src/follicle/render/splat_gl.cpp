@@ -294,7 +294,8 @@ void SplatPassGl::bind_common(GLuint prog, int order_base) {
   gl::set_i(prog, "uIntensityWidth", m_intensity_w > 0 ? m_intensity_w : 1);
 }
 
-void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao) {
+void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao,
+                             tbb::task_arena& arena) {
   m_light_done = false;
   m_intensity.clear();
   if (m_count == 0) return;
@@ -350,7 +351,7 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
   if (settings.hair_light_pass == "gpu")
     light_slices_gpu(light, std::size_t(settings.hair_light_slices));
   else
-    light_exact_cpu(light);
+    light_exact_cpu(light, arena);
   glDisable(GL_BLEND);
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
@@ -359,7 +360,7 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
   m_light_done = true;  // line 12: m_light_tex is the light map
 }
 
-void SplatPassGl::light_exact_cpu(const Light& light) {
+void SplatPassGl::light_exact_cpu(const Light& light, tbb::task_arena& arena) {
   const std::size_t n = m_count;
   // Line 8's test, for all particles at once: the gather program's objects' visibility (its
   // hair-light value reads a stale buffer and is not used).
@@ -384,7 +385,8 @@ void SplatPassGl::light_exact_cpu(const Light& light) {
   prm.light_vp = light.light_vp;
   prm.travel = light.travel;
   prm.size = m_light_size;
-  splat_light_pass_bando2003(prm, m_cpu_particles, cpu_hair_texture(), m_cpu_result);
+  const SplatAlphaTexture& tex = cpu_hair_texture();
+  arena.execute([&] { splat_light_pass_bando2003(prm, m_cpu_particles, tex, m_cpu_result); });
 
   // The view pass reads (visibility, light through the hair) per particle (line 20), the
   // meshes the light map (line 16).

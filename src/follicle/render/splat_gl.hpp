@@ -51,8 +51,10 @@ class SplatPassGl {
     GLuint shadow_tex = 0;  // objects' depth map (compare mode), over the same light_vp
     double shadow_texel = 0, shadow_bias = 0;
   };
-  /// Lines 6-12. Changes the framebuffer binding, viewport, blend state and texture units.
-  void light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao);
+  /// Lines 6-12. Changes the framebuffer binding, viewport, blend state and texture units; the
+  /// "cpu" pass runs its threads in `arena`.
+  void light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao,
+                  tbb::task_arena& arena);
   /// The light map (R: light transmitted through the hair) of the last light_pass(), 0 if none
   /// was made this frame. Same projection as the shadow map.
   GLuint light_map() const { return m_light_done ? m_light_tex : 0; }
@@ -74,7 +76,7 @@ class SplatPassGl {
   const SplatAlphaTexture& cpu_hair_texture();
   const SplatColorTexture& cpu_hair_color_texture();
   void light_slices_gpu(const Light& light, std::size_t slices);
-  void light_exact_cpu(const Light& light);
+  void light_exact_cpu(const Light& light, tbb::task_arena& arena);
   void ensure_intensity(std::size_t n);
   void ensure_light_buffer(int size);
   void bind_common(GLuint prog, int order_base);

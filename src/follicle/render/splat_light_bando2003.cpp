@@ -2,46 +2,61 @@
 // splat_light_bando2003.hpp and docs/adr/0005-cpu-splat-light-pass.md.
 #include "follicle/render/splat_light_bando2003.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
 
 #include "follicle/core/error.hpp"
+#include "follicle/render/splat_bando2003.hpp"
 
 namespace follicle::render {
 namespace {
 
-/// Bilinear read of a row-major float image with clamped edges; (x, y) in texel units with
-/// texel centres at integer + 1/2.
-float bilinear(const std::vector<float>& img, int w, int h, double x, double y) {
+/// Where a bilinear read of a w x h row-major float image with clamped edges samples: rows ya
+/// and yb (yb is ya or ya + 1), columns xa and xb, weights fx and fy.
+struct BilinearTap {
+  int xa = 0, xb = 0, ya = 0, yb = 0;
+  float fx = 0, fy = 0;
+};
+
+/// The taps of a bilinear read at (x, y) in texel units with texel centres at integer + 1/2.
+BilinearTap bilinear_tap(int w, int h, double x, double y) {
   x -= 0.5;
   y -= 0.5;
   const double fx0 = std::floor(x), fy0 = std::floor(y);
-  const float fx = float(x - fx0), fy = float(y - fy0);
+  BilinearTap t;
+  t.fx = float(x - fx0);
+  t.fy = float(y - fy0);
   const int x0 = int(fx0), y0 = int(fy0);
-  const int xa = std::clamp(x0, 0, w - 1), xb = std::clamp(x0 + 1, 0, w - 1);
-  const int ya = std::clamp(y0, 0, h - 1), yb = std::clamp(y0 + 1, 0, h - 1);
-  const float* ra = img.data() + std::size_t(ya) * std::size_t(w);
-  const float* rb = img.data() + std::size_t(yb) * std::size_t(w);
-  const float top = ra[xa] + fx * (ra[xb] - ra[xa]);
-  const float bot = rb[xa] + fx * (rb[xb] - rb[xa]);
-  return top + fy * (bot - top);
+  t.xa = std::clamp(x0, 0, w - 1);
+  t.xb = std::clamp(x0 + 1, 0, w - 1);
+  t.ya = std::clamp(y0, 0, h - 1);
+  t.yb = std::clamp(y0 + 1, 0, h - 1);
+  return t;
 }
 
-/// billboard_axes() of kSplatCommon (Bando 2003 §3.4, Fig. 3.5(b)): the billboard lies across
-/// d_p with its vertical axis along the projection of t; s = max(sin(theta), min_sin).
-void billboard_axes(const Vec3& t, const Vec3& dp, double min_sin, Vec3& along, Vec3& across,
-                    double& s) {
-  Vec3 tp = t - t.dot(dp) * dp;
-  double st = tp.norm();
-  if (st < 1e-6) {
-    tp = dp.cross(std::abs(dp.x()) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
-    st = 0;
-  }
-  along = tp.normalized();
-  across = dp.cross(along).normalized();
-  s = std::max(st, min_sin);
+/// The horizontal half of a bilinear read of `t` in one of its rows `r`.
+inline float bilinear_row(const float* r, const BilinearTap& t) {
+  return r[t.xa] + t.fx * (r[t.xb] - r[t.xa]);
+}
+
+/// The vertical half: the read of `t` from its rows' values `top` (row ya) and `bot` (row yb).
+inline float bilinear_mix(float top, float bot, const BilinearTap& t) {
+  return top + t.fy * (bot - top);
+}
+
+/// Bilinear read of a row-major float image with clamped edges; (x, y) in texel units with
+/// texel centres at integer + 1/2.
+float bilinear(const std::vector<float>& img, int w, int h, double x, double y) {
+  const BilinearTap t = bilinear_tap(w, h, x, y);
+  return bilinear_mix(bilinear_row(img.data() + std::size_t(t.ya) * std::size_t(w), t),
+                      bilinear_row(img.data() + std::size_t(t.yb) * std::size_t(w), t), t);
 }
 
 /// [lo, hi] of x where 0 <= c + k x <= 1 (empty: lo > hi).
@@ -167,9 +182,80 @@ std::vector<int32_t> splat_light_order(const Vec3& travel,
   return order;
 }
 
+namespace {
+
+/// Rows per band of the parallel light pass (see splat_light_pass_bando2003_banded()). Any
+/// value gives the same result; 16 gives 2 threads enough bands to balance when the hair covers
+/// only part of a 512^2 buffer, for one pass over the particles' row spans per band.
+constexpr int kBandRows = 16;
+
+/// One particle of the loop (line 8), set up once before the bands: its 5 line-9 reads and its
+/// line-10 light-view billboard.
+struct LightSplat {
+  int32_t idx = 0;  // input index
+  /// Line 9: where the 5 taps read the buffer; tap j is outside the buffer (reads 1) when
+  /// inside[j] is false. Tap 0 is the centre, 1 and 2 at +-da, 3 and 4 at +-dc.
+  std::array<BilinearTap, 5> tap{};
+  std::array<bool, 5> inside{};
+  /// Line 10: rows y0..y1 (none when y0 > y1) of the billboard (u, v) = M (x - w0), opacity
+  /// fa, hair texture level `level`.
+  int y0 = 0, y1 = -1;
+  float fa = 0;
+  Vec2 w0 = Vec2::Zero();
+  double m00 = 0, m01 = 0, m10 = 0, m11 = 0;
+  int level = 0;
+};
+
+/// Rows a particle touches: its splat rows and the rows its taps read (lo > hi: none).
+struct RowSpan {
+  int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
+};
+
+/// Line 10 for one row y of the billboard of `q`: row[x] *= 1 - a * alpha_tex over the pixel
+/// centres of row y inside the billboard.
+void splat_row(const LightSplat& q, int y, int size, const float* tex, int lw, int lh, float* row) {
+  const int stride = lw + 2;
+  const Vec2& w0 = q.w0;
+  // Pixel centres (x + 1/2, y + 1/2) with u, v in [0, 1]: u and v are linear in x.
+  const double py = y + 0.5 - w0.y();
+  const double cu = q.m01 * py - q.m00 * w0.x(), cv = q.m11 * py - q.m10 * w0.x();
+  double ulo, uhi, vlo, vhi;
+  unit_interval(cu, q.m00, ulo, uhi);
+  unit_interval(cv, q.m10, vlo, vhi);
+  const double lo = std::max(ulo, vlo), hi = std::min(uhi, vhi);
+  if (!(lo <= hi)) return;
+  const int x0 = std::max(0, int(std::ceil(std::max(lo - 0.5, -1.0))));
+  const int x1 = std::min(size - 1, int(std::ceil(std::min(hi - 0.5, double(size)))) - 1);
+  // Padded texel coordinates of the level (u w + 1/2, v h + 1/2), linear along the row.
+  const double tx0 = (cu + q.m00 * (x0 + 0.5)) * lw + 0.5,
+               ty0 = (cv + q.m10 * (x0 + 0.5)) * lh + 0.5;
+  const float dtx = float(q.m00 * lw), dty = float(q.m10 * lh);
+  const float txlo = 0.5f, txhi = float(lw) + 0.5f, tylo = 0.5f, tyhi = float(lh) + 0.5f;
+  const float fa = q.fa;
+  for (int x = x0; x <= x1; ++x) {
+    const float k = float(x - x0);
+    const float tx = std::clamp(float(tx0) + k * dtx, txlo, txhi);
+    const float ty = std::clamp(float(ty0) + k * dty, tylo, tyhi);
+    row[x] *= 1.0f - fa * padded_bilinear(tex, stride, tx, ty);  // ZERO, 1 - SRC_ALPHA
+  }
+}
+
+}  // namespace
+
 void splat_light_pass_bando2003(const SplatLightParams& params,
                                 std::span<const LightSplatParticle> particles,
                                 const SplatAlphaTexture& texture, SplatLightResult& out) {
+  // One thread: one band (no per-band overhead); the result is the same.
+  const bool parallel = tbb::this_task_arena::max_concurrency() > 1;
+  detail::splat_light_pass_bando2003_banded(params, particles, texture, out,
+                                            parallel ? kBandRows : std::max(1, params.size));
+}
+
+void detail::splat_light_pass_bando2003_banded(const SplatLightParams& params,
+                                               std::span<const LightSplatParticle> particles,
+                                               const SplatAlphaTexture& texture,
+                                               SplatLightResult& out, int band_rows) {
+  if (band_rows < 1) fail("splat light pass: band height {} is not >= 1", band_rows);
   const int size = params.size;
   if (size < 1 || size > 16384)
     fail("splat light pass: light buffer size {} is outside [1, 16384]", size);
@@ -191,84 +277,125 @@ void splat_light_pass_bando2003(const SplatLightParams& params,
   auto window = [&](const Vec3& p) -> Vec2 { return A * p + b; };
 
   // Line 1 (and 6): a white buffer.
+  const std::size_t n = particles.size();
   const std::size_t npix = std::size_t(size) * std::size_t(size);
   out.light.assign(npix, 1.0f);
-  out.reach.assign(particles.size(), 1.0f);
-  std::vector<float>& buf = out.light;
-  // Line 9's read: the bilinear buffer value at a world point (1 outside the buffer, as in
-  // kSplatGatherVs's light_buffer()).
-  auto read = [&](const Vec3& p) -> double {
-    const Vec2 w = window(p);
-    if (!(w.x() >= 0 && w.x() <= size && w.y() >= 0 && w.y() <= size)) return 1.0;
-    return double(bilinear(buf, size, size, w.x(), w.y()));
-  };
+  out.reach.assign(n, 1.0f);
+  if (n == 0) return;
   const int tw = texture.width(), th = texture.height();
 
   // Line 7: ascending depth from the light.
   const std::vector<int32_t> order = splat_light_order(params.travel, particles);
-  for (const int32_t idx : order) {  // line 8
-    const LightSplatParticle& p = particles[std::size_t(idx)];
+
+  // The loop of lines 8-11 is sequential by definition (each read sees every earlier splat),
+  // but a pixel only ever depends on the same pixel: the buffer is cut into bands of rows and
+  // every band runs the whole loop on its own rows, in parallel. A bilinear read of rows ya and
+  // yb = ya + 1 is a lerp within each row then one between the rows: at every particle's turn
+  // the band holding ya computes the first row's lerp, the band holding yb the second's, and
+  // the lerp between them is done after all bands, with the same float operations, so every
+  // value is bit-identical to the sequential loop's for any band height and thread count.
+  // First, per particle (in loop order k, in parallel): where its reads fall and its billboard.
+  std::vector<LightSplat> splats(n);
+  std::vector<RowSpan> spans(n);
+  auto setup = [&](std::size_t k) {
+    LightSplat& q = splats[k];
+    RowSpan& span = spans[k];
+    q.idx = order[k];
+    const LightSplatParticle& p = particles[std::size_t(q.idx)];
     Vec3 along, across;
     double s = 1;
-    billboard_axes(p.t, params.travel, p.min_sin, along, across, s);
-    // Line 9: the light reaching the particle, averaged over 5 taps of its footprint (the same
-    // weights as kSplatGatherVs).
+    splat_billboard_axes(p.t, params.travel, p.min_sin, along, across, s);
+    // Line 9: the light reaching the particle, averaged over 5 taps of its footprint (the
+    // same weights as kSplatGatherVs); a tap outside the buffer reads 1, as in
+    // kSplatGatherVs's light_buffer().
     const Vec3 da = 0.5 * p.half_l * s * along, dc = 0.5 * p.half_w * across;
-    out.reach[std::size_t(idx)] =
-        float(0.4 * read(p.pos) +
-              0.15 * (read(p.pos + da) + read(p.pos - da) + read(p.pos + dc) + read(p.pos - dc)));
+    const std::array<Vec3, 5> at = {p.pos, Vec3(p.pos + da), Vec3(p.pos - da), Vec3(p.pos + dc),
+                                    Vec3(p.pos - dc)};
+    for (std::size_t j = 0; j < 5; ++j) {
+      const Vec2 w = window(at[j]);
+      q.inside[j] = w.x() >= 0 && w.x() <= size && w.y() >= 0 && w.y() <= size;
+      if (!q.inside[j]) continue;
+      q.tap[j] = bilinear_tap(size, size, w.x(), w.y());
+      span.lo = std::min(span.lo, q.tap[j].ya);
+      span.hi = std::max(span.hi, q.tap[j].yb);
+    }
 
     // Line 10: the light-view billboard (billboard_corner() with d_p = the light travel) of
-    // opacity alpha/sin(theta) (§3.4) times the shadow opacity scale, not splatted when in the
-    // objects' shadow (line 8, weighted by the PCF visibility) or not casting.
+    // opacity alpha/sin(theta) (§3.4) times the shadow opacity scale, not splatted when in
+    // the objects' shadow (line 8, weighted by the PCF visibility) or not casting.
     const double a = std::min(1.0, p.alpha / s * p.opacity_scale) * p.vis * (p.casts ? 1.0 : 0.0);
-    if (!(a > 0)) continue;
+    if (!(a > 0)) return;
     const Vec3 eu = 2 * p.half_w * across, ev = 2 * p.half_l * s * along;
     const Vec2 w0 = window(p.pos - 0.5 * eu - 0.5 * ev);  // corner uv = (0, 0)
     const Vec2 wu = A * eu, wv = A * ev;                  // window edges along u and v
     const double det = wu.x() * wv.y() - wu.y() * wv.x();
-    if (!(std::abs(det) > 1e-12)) continue;  // edge-on: covers no pixel centre
+    if (!(std::abs(det) > 1e-12)) return;  // edge-on: covers no pixel centre
     // (u, v) = M (x - w0) with M the inverse of [wu wv].
-    const double m00 = wv.y() / det, m01 = -wv.x() / det, m10 = -wu.y() / det, m11 = wu.x() / det;
+    q.m00 = wv.y() / det;
+    q.m01 = -wv.x() / det;
+    q.m10 = -wu.y() / det;
+    q.m11 = wu.x() / det;
     // Mip level from the texel footprint per pixel (constant: the projection is affine).
-    const double rho = std::max(std::hypot(tw * m00, th * m10), std::hypot(tw * m01, th * m11));
-    const int level = texture.level_for(rho);
-    const float* tex = texture.padded(level);
-    const int lw = texture.width(level), lh = texture.height(level), stride = lw + 2;
+    const double rho =
+        std::max(std::hypot(tw * q.m00, th * q.m10), std::hypot(tw * q.m01, th * q.m11));
+    q.level = texture.level_for(rho);
+    q.w0 = w0;
+    q.fa = float(a);
     double ymin = w0.y(), ymax = w0.y();
     for (const Vec2& c : {Vec2(w0 + wu), Vec2(w0 + wv), Vec2(w0 + wu + wv)}) {
       ymin = std::min(ymin, c.y());
       ymax = std::max(ymax, c.y());
     }
-    // Pixel centres inside the billboard, half-open like GL's rasterisation rule (a centre on
-    // the top or right edge is not covered): y in [ymin, ymax), x in [lo, hi).
-    const int y0 = std::max(0, int(std::ceil(ymin - 0.5)));
-    const int y1 = std::min(size - 1, int(std::ceil(ymax - 0.5)) - 1);
-    for (int y = y0; y <= y1; ++y) {
-      // Pixel centres (x + 1/2, y + 1/2) with u, v in [0, 1]: u and v are linear in x.
-      const double py = y + 0.5 - w0.y();
-      const double cu = m01 * py - m00 * w0.x(), cv = m11 * py - m10 * w0.x();
-      double ulo, uhi, vlo, vhi;
-      unit_interval(cu, m00, ulo, uhi);
-      unit_interval(cv, m10, vlo, vhi);
-      const double lo = std::max(ulo, vlo), hi = std::min(uhi, vhi);
-      if (!(lo <= hi)) continue;
-      const int x0 = std::max(0, int(std::ceil(std::max(lo - 0.5, -1.0))));
-      const int x1 = std::min(size - 1, int(std::ceil(std::min(hi - 0.5, double(size)))) - 1);
-      // Padded texel coordinates of the level (u w + 1/2, v h + 1/2), linear along the row.
-      const double tx0 = (cu + m00 * (x0 + 0.5)) * lw + 0.5,
-                   ty0 = (cv + m10 * (x0 + 0.5)) * lh + 0.5;
-      const float dtx = float(m00 * lw), dty = float(m10 * lh);
-      const float txlo = 0.5f, txhi = float(lw) + 0.5f, tylo = 0.5f, tyhi = float(lh) + 0.5f;
-      const float fa = float(a);
-      float* row = buf.data() + std::size_t(y) * std::size_t(size);
-      for (int x = x0; x <= x1; ++x) {
-        const float k = float(x - x0);
-        const float tx = std::clamp(float(tx0) + k * dtx, txlo, txhi);
-        const float ty = std::clamp(float(ty0) + k * dty, tylo, tyhi);
-        row[x] *= 1.0f - fa * padded_bilinear(tex, stride, tx, ty);  // ZERO, 1 - SRC_ALPHA
-      }
+    // Pixel centres inside the billboard, half-open like GL's rasterisation rule (a centre
+    // on the top or right edge is not covered): y in [ymin, ymax), x in [lo, hi).
+    q.y0 = std::max(0, int(std::ceil(ymin - 0.5)));
+    q.y1 = std::min(size - 1, int(std::ceil(ymax - 0.5)) - 1);
+    if (q.y0 <= q.y1) {
+      span.lo = std::min(span.lo, q.y0);
+      span.hi = std::max(span.hi, q.y1);
     }
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) setup(k);
+                    });
+
+  // Lines 8-11 per band of rows [r0, r1); the row lerps of tap j of loop step k go to
+  // top[5 k + j] (row ya) and bot[5 k + j] (row yb).
+  std::vector<float> top(5 * n, 1.0f), bot(5 * n, 1.0f);
+  float* const buf = out.light.data();
+  const int nbands = (size + band_rows - 1) / band_rows;
+  auto run_band = [&](int band) {
+    const int r0 = band * band_rows, r1 = std::min(size, r0 + band_rows);
+    auto row = [&](int y) { return buf + std::size_t(y) * std::size_t(size); };
+    for (std::size_t k = 0; k < n; ++k) {  // line 8, in the order of line 7
+      if (spans[k].hi < r0 || spans[k].lo >= r1) continue;
+      const LightSplat& q = splats[k];
+      for (std::size_t j = 0; j < 5; ++j) {  // line 9: the row lerps in this band
+        const BilinearTap& t = q.tap[j];
+        if (!q.inside[j]) continue;
+        if (t.ya >= r0 && t.ya < r1) top[5 * k + j] = bilinear_row(row(t.ya), t);
+        if (t.yb >= r0 && t.yb < r1) bot[5 * k + j] = bilinear_row(row(t.yb), t);
+      }
+      const int y0 = std::max(q.y0, r0), y1 = std::min(q.y1, r1 - 1);  // line 10
+      if (y0 > y1) continue;
+      const float* tex = texture.padded(q.level);
+      const int lw = texture.width(q.level), lh = texture.height(q.level);
+      for (int y = y0; y <= y1; ++y) splat_row(q, y, size, tex, lw, lh, row(y));
+    }
+  };
+  tbb::parallel_for(tbb::blocked_range<int>(0, nbands, 1), [&](const tbb::blocked_range<int>& r) {
+    for (int band = r.begin(); band != r.end(); ++band) run_band(band);
+  });
+
+  // Line 9: each tap's read, then their 5-tap average in the order and precision of
+  // kSplatGatherVs's weights (a tap outside the buffer reads 1).
+  for (std::size_t k = 0; k < n; ++k) {
+    const LightSplat& q = splats[k];
+    std::array<double, 5> v{};
+    for (std::size_t j = 0; j < 5; ++j)
+      v[j] = q.inside[j] ? double(bilinear_mix(top[5 * k + j], bot[5 * k + j], q.tap[j])) : 1.0;
+    out.reach[std::size_t(q.idx)] = float(0.4 * v[0] + 0.15 * (v[1] + v[2] + v[3] + v[4]));
   }
   // Line 12: `buf` is the light map.
 }

@@ -90,11 +90,23 @@ struct SplatLightResult {
 std::vector<int32_t> splat_light_order(const Vec3& travel,
                                        std::span<const LightSplatParticle> particles);
 
-/// Lines 6-12 for `particles` (exact per-particle read, no slicing). Reuses `out`'s storage.
+/// Lines 6-12 for `particles` (exact per-particle read, no slicing), in parallel over bands of
+/// buffer rows with TBB in the caller's task arena, bit-identical to the sequential loop for
+/// any thread count. Reuses `out`'s storage.
 /// Throws follicle::Error naming the particle for non-finite or out-of-range data, and for a
 /// non-orthographic projection, a size outside [1, 16384] or a non-unit travel direction.
 void splat_light_pass_bando2003(const SplatLightParams& params,
                                 std::span<const LightSplatParticle> particles,
                                 const SplatAlphaTexture& texture, SplatLightResult& out);
+
+namespace detail {
+/// splat_light_pass_bando2003() with the buffer cut into bands of `band_rows` rows (>= 1), run
+/// in parallel with TBB in the caller's task arena. The result is bit-identical to the
+/// sequential loop for every band height and thread count (tested).
+void splat_light_pass_bando2003_banded(const SplatLightParams& params,
+                                       std::span<const LightSplatParticle> particles,
+                                       const SplatAlphaTexture& texture, SplatLightResult& out,
+                                       int band_rows);
+}  // namespace detail
 
 }  // namespace follicle::render

@@ -257,10 +257,8 @@ void splat_rows(const std::vector<Setup>& setups, std::span<const int32_t> order
       // the empty part of the billboard (kSplatViewFs discards alpha < 0.004) blends with
       // sa = 0, which leaves it unchanged: selecting instead of branching keeps the loop free
       // of unpredictable jumps.
-      auto shade = [&](int k, float tx, float ty, bool front) {
-        const int ix = int(tx), iy = int(ty);  // tx, ty > 0: truncation is floor
-        const float fx = tx - float(ix), fy = ty - float(iy);
-        const float* t0 = texels + 4 * (std::size_t(iy) * std::size_t(stride) + std::size_t(ix));
+      auto shade = [&](int k, std::size_t texel, float fx, float fy, bool front) {
+        const float* t0 = texels + 4 * texel;
         const float* t1 = t0 + 4 * std::size_t(stride);
         const V4 a00 = load4(t0), a01 = load4(t0 + 4), a10 = load4(t1), a11 = load4(t1 + 4);
         const V4 top = a00 + fx * (a01 - a00), bot = a10 + fx * (a11 - a10);
@@ -286,7 +284,12 @@ void splat_rows(const std::vector<Setup>& setups, std::span<const int32_t> order
         ty = ty < lo_v ? lo_v : ty;
         ty = ty > tyhi_v ? tyhi_v : ty;
         const V4I front = depth < load4(dwin + k);  // GL_LESS against the objects
-        for (int l = 0; l < 4; ++l) shade(k + l, tx[l], ty[l], front[l] != 0);
+        const V4I ix = __builtin_convertvector(tx, V4I), iy = __builtin_convertvector(ty, V4I);
+        const V4 fx = tx - __builtin_convertvector(ix, V4),
+                 fy = ty - __builtin_convertvector(iy, V4);
+        const V4I texel = iy * stride + ix;
+        for (int l = 0; l < 4; ++l)
+          shade(k + l, std::size_t(texel[l]), fx[l], fy[l], front[l] != 0);
       }
       for (; k <= k1; ++k) {
         const float fk = float(k);
@@ -294,7 +297,9 @@ void splat_rows(const std::vector<Setup>& setups, std::span<const int32_t> order
         const float iq = 1.0f / (q0 + dq * fk);
         const float tx = std::clamp((a0 + da * fk) * iq + 0.5f, 0.5f, txhi);
         const float ty = std::clamp((b0 + db * fk) * iq + 0.5f, 0.5f, tyhi);
-        shade(k, tx, ty, depth < dwin[k]);
+        const int ix = int(tx), iy = int(ty);  // tx, ty > 0: truncation is floor
+        shade(k, std::size_t(iy) * std::size_t(stride) + std::size_t(ix), tx - float(ix),
+              ty - float(iy), depth < dwin[k]);
       }
     }
   }
