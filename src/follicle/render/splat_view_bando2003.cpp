@@ -51,17 +51,24 @@ struct Setup {
 };
 
 /// Sets the 7 half-planes of the coverage (see the file comment): q > 0 (in front of the eye;
-/// made strict by a margin far below a pixel), a >= 0, q w - a >= 0 (u in [0, 1], a scaled
-/// by the level width w), b >= 0, q h - b >= 0, 1 + z >= 0, 1 - z >= 0.
-void set_constraints(Setup& st, double w, double h) {
+/// made strict by a margin far below a pixel), a >= u0 q, u1 q - a >= 0 (u w in [u0, u1], a
+/// scaled by the level width w), the same for b and [v0, v1], 1 + z >= 0, 1 - z >= 0. [u0, u1]
+/// is [0, w] narrowed to where the texture is not empty: a sample at texel coordinate
+/// u w + 1/2 < c0 (the first column with alpha >= the discard threshold) reads only columns
+/// before c0, one at >= c1 + 2 only columns after c1, and a bilinear mix of texels below the
+/// threshold stays below it, so those pixels would be discarded anyway.
+void set_constraints(Setup& st, double w, double h, const std::array<int, 4>& cover) {
+  const double u0 = std::max(0.0, cover[0] - 0.5), u1 = std::min(w, cover[1] + 1.5);
+  const double v0 = std::max(0.0, cover[2] - 0.5), v1 = std::min(h, cover[3] + 1.5);
   const double qs = 1e-9 * (std::abs(st.q[0]) + std::abs(st.q[1]) + std::abs(st.q[2]));
-  const double rows[7][3] = {{st.q[0], st.q[1], st.q[2] - qs},
-                             {st.a[0], st.a[1], st.a[2]},
-                             {w * st.q[0] - st.a[0], w * st.q[1] - st.a[1], w * st.q[2] - st.a[2]},
-                             {st.b[0], st.b[1], st.b[2]},
-                             {h * st.q[0] - st.b[0], h * st.q[1] - st.b[1], h * st.q[2] - st.b[2]},
-                             {st.z[0], st.z[1], 1 + st.z[2]},
-                             {-st.z[0], -st.z[1], 1 - st.z[2]}};
+  const double rows[7][3] = {
+      {st.q[0], st.q[1], st.q[2] - qs},
+      {st.a[0] - u0 * st.q[0], st.a[1] - u0 * st.q[1], st.a[2] - u0 * st.q[2]},
+      {u1 * st.q[0] - st.a[0], u1 * st.q[1] - st.a[1], u1 * st.q[2] - st.a[2]},
+      {st.b[0] - v0 * st.q[0], st.b[1] - v0 * st.q[1], st.b[2] - v0 * st.q[2]},
+      {v1 * st.q[0] - st.b[0], v1 * st.q[1] - st.b[1], v1 * st.q[2] - st.b[2]},
+      {st.z[0], st.z[1], 1 + st.z[2]},
+      {-st.z[0], -st.z[1], 1 - st.z[2]}};
   for (int i = 0; i < 7; ++i) {
     st.d[i] = rows[i][0];
     st.c1[i] = rows[i][1];
@@ -199,7 +206,9 @@ Setup make_setup(const SplatViewParams& prm, const ViewSplatParticle& p,
   const double lw = tex.width(st.level), lh = tex.height(st.level);
   for (double& c : st.a) c *= lw;
   for (double& c : st.b) c *= lh;
-  set_constraints(st, lw, lh);
+  const std::array<int, 4>& cover = tex.coverage(st.level);
+  if (cover[0] > cover[1]) return st;  // the whole level is below the discard threshold
+  set_constraints(st, lw, lh, cover);
   for (int c = 0; c < 3; ++c) st.color[c] = float(p.color[c]);
   st.alpha = float(std::min(1.0, p.alpha / s));  // Bando 2003 §3.4: opacity / sin(theta)
   st.bx0 = box[0];
@@ -263,7 +272,8 @@ void splat_rows(const std::vector<Setup>& setups, std::span<const int32_t> order
         const V4 a00 = load4(t0), a01 = load4(t0 + 4), a10 = load4(t1), a11 = load4(t1 + 4);
         const V4 top = a00 + fx * (a01 - a00), bot = a10 + fx * (a11 - a10);
         V4 t = top + fy * (bot - top);
-        const float sa = front && t[3] >= 0.004f ? st.alpha * t[3] : 0.0f;
+        const float sa =
+            front && t[3] >= SplatColorTexture::kSplatAlphaDiscard ? st.alpha * t[3] : 0.0f;
         t[3] = 1.0f;  // colour (r, g, b, 1) x texel (r, g, b, 1) x sa: alpha sa
         float* px = cwin + 4 * std::ptrdiff_t(k);
         store4(px, colour * t * sa + load4(px) * (1.0f - sa));
@@ -330,6 +340,19 @@ SplatColorTexture::SplatColorTexture(const image::ImageRGBA8& img) : m_alpha(non
       std::vector<float>& dst = m_rgba[std::size_t(l)];
       for (std::size_t i = 0; i < dst.size() / 4; ++i) dst[4 * i + std::size_t(c)] = src[i];
     }
+  }
+  for (int l = 0; l < levels(); ++l) {
+    const int w = width(l), h = height(l);
+    std::array<int, 4> box = {w, -1, h, -1};
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        if (m_rgba[std::size_t(l)]
+                  [4 * (std::size_t(y + 1) * std::size_t(w + 2) + std::size_t(x + 1)) + 3] >=
+            kSplatAlphaDiscard) {
+          box = {std::min(box[0], x), std::max(box[1], x), std::min(box[2], y),
+                 std::max(box[3], y)};
+        }
+    m_cover.push_back(box);
   }
 }
 

@@ -18,6 +18,7 @@
 // split into bands run in parallel, each band walking all particles in the same order, so the
 // result is identical for any thread count. docs/adr/0007-cpu-splat-view-pass.md says why this
 // is the default on a software rasteriser.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -53,10 +54,18 @@ class SplatColorTexture {
   int level_for(double rho) const { return m_alpha.level_for(rho); }
   /// (w + 2) x (h + 2) RGBA texels of a level, texel (x, y) at 4 [(y + 1)(w + 2) + x + 1].
   const float* padded_rgba(int level) const { return m_rgba[std::size_t(level)].data(); }
+  /// Texels of a level with alpha >= kSplatAlphaDiscard lie in columns [box[0], box[1]] and
+  /// rows [box[2], box[3]] (level texel indices); an empty level has box[0] > box[1]. A sample
+  /// whose bilinear footprint lies outside is discarded, so the pass skips those pixels.
+  const std::array<int, 4>& coverage(int level) const { return m_cover[std::size_t(level)]; }
+
+  /// kSplatViewFs discards fragments whose texel alpha is below this.
+  static constexpr float kSplatAlphaDiscard = 0.004f;
 
  private:
-  SplatAlphaTexture m_alpha;               // the alpha chain (and the level geometry)
-  std::vector<std::vector<float>> m_rgba;  // per level, interleaved
+  SplatAlphaTexture m_alpha;                // the alpha chain (and the level geometry)
+  std::vector<std::vector<float>> m_rgba;   // per level, interleaved
+  std::vector<std::array<int, 4>> m_cover;  // per level, see coverage()
 };
 
 /// The colour and depth buffers the pass draws into: a window of a GL framebuffer, rows bottom

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -173,6 +174,35 @@ TEST(SplatView, TextureRowZeroIsAtTheRootSideEnd) {
     if (b.px(32, y)[0] != 0.2f) (y < 24 ? low : high)++;
   EXPECT_GT(low, 2);
   EXPECT_EQ(high, 0);
+}
+
+TEST(SplatView, EmptyTextureMarginsAreSkippedWithoutChangingPixels) {
+  // A streak in texel columns 3-4 and rows 2-12 of a 8 x 16 texture: the pass narrows each
+  // row to the texture's non-empty box. Every pixel changes exactly when the bilinear alpha
+  // at its (u, v) (SplatAlphaTexture::sample, level 0: the billboard is magnified) reaches the
+  // discard threshold.
+  image::ImageRGBA8 img(8, 16, uint8_t(255));
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 8; ++x) img.at(x, y, 3) = (x == 3 || x == 4) && y >= 2 && y <= 12 ? 200 : 0;
+  const SplatColorTexture tex(img);
+  EXPECT_EQ(tex.coverage(0), (std::array<int, 4>{3, 4, 2, 12}));
+  const SplatAlphaTexture alpha(img);
+  Buffers b;
+  ViewSplatParticle p = particle(Vec3(1, 1, 1), 1);
+  p.half_w = 5.0 / 32;  // 10 px for 8 texels: samples fall between texel centres
+  p.half_l = 11.0 / 32;  // 22 px for 16 texels
+  splat_view_pass_bando2003(ortho(), std::vector<ViewSplatParticle>{p}, identity_order(1), tex,
+                            b.target());
+  int drawn = 0;
+  for (int y = 13; y < 35; ++y)
+    for (int x = 27; x < 37; ++x) {
+      const double u = (x + 0.5 - 27) / 10, v = (y + 0.5 - 13) / 22;
+      const bool expect = alpha.sample(u, v, 0) >= SplatColorTexture::kSplatAlphaDiscard;
+      EXPECT_EQ(b.px(x, y)[0] != 0.2f, expect) << x << "," << y;
+      drawn += expect;
+    }
+  EXPECT_GT(drawn, 20);
+  EXPECT_LT(drawn, 10 * 22 / 2);
 }
 
 TEST(SplatView, PerspectiveBillboardMatchesItsProjectedArea) {
