@@ -232,8 +232,8 @@ class GlRenderer final : public Renderer {
     if (draw(scene, settings, &m_cpu_frame)) {
       // The frame came back for the CPU hair view pass: resolve it here too.
       m_arena->execute([&] {
-        resolve_srgb_cpu(m_cpu_frame.data(), m_fb_w, m_fb_h, settings.supersample,
-                         settings.transparent_background, img);
+        m_resolve.resolve(m_cpu_frame.data(), m_fb_w, m_fb_h, settings.supersample,
+                          settings.transparent_background, img);
       });
       return img;
     }
@@ -610,6 +610,16 @@ class GlRenderer final : public Renderer {
       if (settings.hair_view_pass == "gpu")
         m_splat->view_pass(scene, view, view_proj, m_empty_vao);
       else if (cpu_frame) {
+        // The whole frame as half floats (a plain copy in llvmpipe, where converting to float
+        // costs 1 ms at 512²), widened exactly on the CPU.
+        const std::size_t nf = 4 * std::size_t(m_fb_w) * std::size_t(m_fb_h);
+        m_cpu_half.resize(nf);
+        cpu_frame->resize(nf);
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glReadPixels(0, 0, m_fb_w, m_fb_h, GL_RGBA, GL_HALF_FLOAT, m_cpu_half.data());
+        check_gl("frame read-back");
+        m_arena->execute(
+            [&] { m_resolve.half_to_float(m_cpu_half.data(), nf, cpu_frame->data()); });
         m_splat->view_pass_cpu(scene, view, view_proj, m_color_tex, m_fb_w, m_fb_h, *m_arena,
                                cpu_frame);
         glBindVertexArray(0);
@@ -893,6 +903,8 @@ class GlRenderer final : public Renderer {
   std::shared_ptr<spdlog::logger> m_log;
   std::unique_ptr<tbb::task_arena> m_arena;  // the CPU hair view pass's threads (ctx.threads())
   std::vector<float> m_cpu_frame;            // the frame read back for the CPU view pass
+  std::vector<uint16_t> m_cpu_half;          // ... as read (half floats)
+  CpuResolve m_resolve;                      // its resolve tables
   std::unique_ptr<EglContext> m_egl;
   std::string m_description;
   std::map<int, GLuint> m_mesh_progs;

@@ -5,8 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "follicle/core/error.hpp"
@@ -33,17 +33,40 @@ double srgb_encode(double c) {
   return c < 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
 }
 
+float half_bits_to_float(uint16_t h) {
+  const int e = (h >> 10) & 31, m = h & 1023;
+  const float mag = e == 0    ? std::ldexp(float(m), -24)  // zero and subnormals
+                    : e == 31 ? (m == 0 ? std::numeric_limits<float>::infinity()
+                                        : std::numeric_limits<float>::quiet_NaN())
+                              : std::ldexp(float(1024 + m), e - 25);
+  return (h & 0x8000) ? -mag : mag;
+}
+
+CpuResolve::CpuResolve() : m_srgb(kTable + 2), m_half(65536) {
+  for (int i = 0; i <= kTable; ++i) m_srgb[std::size_t(i)] = float(srgb_encode(double(i) / kTable));
+  m_srgb[kTable + 1] = m_srgb[kTable];
+  for (uint32_t h = 0; h < 65536; ++h) m_half[h] = half_bits_to_float(uint16_t(h));
+}
+
+void CpuResolve::half_to_float(const uint16_t* src, std::size_t n, float* dst) const {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) dst[i] = m_half[src[i]];
+                    });
+}
+
 void resolve_srgb_cpu(const float* rgba, int fb_w, int fb_h, int k, bool unpremultiply,
                       image::ImageRGBA8& out) {
+  CpuResolve().resolve(rgba, fb_w, fb_h, k, unpremultiply, out);
+}
+
+void CpuResolve::resolve(const float* rgba, int fb_w, int fb_h, int k, bool unpremultiply,
+                         image::ImageRGBA8& out) const {
   if (k < 1) fail("resolve: supersampling factor {} is not >= 1", k);
   if (!rgba || out.empty() || fb_w != k * out.width() || fb_h != k * out.height())
     fail("resolve: a {}x{} frame does not resolve {}x down to {}x{}", fb_w, fb_h, k, out.width(),
          out.height());
-  // sRGB kTable + 1 evenly spaced linear values (the curve's linear toe ends
-  // at 0.0031308, inside the first 13 intervals, where interpolation is exact).
-  std::array<float, kTable + 2> table{};
-  for (int i = 0; i <= kTable; ++i) table[std::size_t(i)] = float(srgb_encode(double(i) / kTable));
-  table[kTable + 1] = table[kTable];
+  const std::vector<float>& table = m_srgb;
   const int w = out.width(), h = out.height();
   const float inv_n = 1.0f / float(k * k);
   // One output pixel from its averaged linear RGBA.

@@ -512,11 +512,8 @@ void SplatPassGl::view_pass_cpu(const RenderScene& scene, const Mat4& view, cons
                                 GLuint color_tex, int fb_w, int fb_h, tbb::task_arena& arena,
                                 std::vector<float>* frame) {
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  if (frame) {  // the whole colour buffer, with or without hair on it
-    frame->resize(4 * std::size_t(fb_w) * std::size_t(fb_h));
-    glReadPixels(0, 0, fb_w, fb_h, GL_RGBA, GL_FLOAT, frame->data());
-    check_gl("frame read-back");
-  }
+  if (frame && frame->size() != 4 * std::size_t(fb_w) * std::size_t(fb_h))
+    fail("render: the read-back frame has {} floats for {}x{} pixels", frame->size(), fb_w, fb_h);
   if (m_count == 0) return;
   const std::size_t n = m_count;
   if (m_light_done && m_intensity.empty()) {  // the "gpu" light pass: read its intensities

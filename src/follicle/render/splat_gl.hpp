@@ -65,8 +65,8 @@ class SplatPassGl {
   /// Lines 17-21 on the CPU for the bound framebuffer, whose colour attachment is `color_tex`
   /// (RGBA16F, fb_w x fb_h) with a depth attachment; runs its threads in `arena`. Without
   /// `frame` the billboards' rectangle is read back, drawn and uploaded again; with it the
-  /// whole colour buffer is read into *frame (fb_w x fb_h RGBA floats, rows bottom up), drawn
-  /// there and not uploaded (the caller resolves it on the CPU).
+  /// caller has read the whole colour buffer into *frame (fb_w x fb_h RGBA floats, rows bottom
+  /// up), the hair is drawn there and not uploaded (the caller resolves it on the CPU).
   void view_pass_cpu(const RenderScene& scene, const Mat4& view, const Mat4& view_proj,
                      GLuint color_tex, int fb_w, int fb_h, tbb::task_arena& arena,
                      std::vector<float>* frame = nullptr);

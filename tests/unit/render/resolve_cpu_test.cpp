@@ -117,3 +117,24 @@ TEST(ResolveCpu, BadSizesFail) {
   image::ImageRGBA8 empty;
   EXPECT_THROW(resolve_srgb_cpu(frame.data(), 4, 4, 1, false, empty), Error);
 }
+
+TEST(ResolveCpu, HalfFloatsWidenExactly) {
+  EXPECT_EQ(half_bits_to_float(0x0000), 0.0f);
+  EXPECT_EQ(half_bits_to_float(0x3C00), 1.0f);
+  EXPECT_EQ(half_bits_to_float(0xC000), -2.0f);
+  EXPECT_EQ(half_bits_to_float(0x3555), 0.333251953125f);
+  EXPECT_EQ(half_bits_to_float(0x7BFF), 65504.0f);               // largest finite
+  EXPECT_EQ(half_bits_to_float(0x0001), std::ldexp(1.0f, -24));  // smallest subnormal
+  EXPECT_EQ(half_bits_to_float(0x0400), std::ldexp(1.0f, -14));  // smallest normal
+  EXPECT_TRUE(std::isinf(half_bits_to_float(0x7C00)));
+  EXPECT_TRUE(std::isnan(half_bits_to_float(0x7E00)));
+  // Every finite pattern: monotone in its magnitude bits, and the table path agrees.
+  std::vector<uint16_t> all(65536);
+  for (uint32_t h = 0; h < 65536; ++h) all[h] = uint16_t(h);
+  std::vector<float> wide(all.size());
+  CpuResolve().half_to_float(all.data(), all.size(), wide.data());
+  for (uint32_t h = 1; h < 0x7C00; ++h) {
+    ASSERT_GT(wide[h], wide[h - 1]) << h;
+    ASSERT_EQ(wide[h | 0x8000], -wide[h]);
+  }
+}
