@@ -2,6 +2,9 @@
 // coverage and blend against hand values, the depth test, the draw order, the texture's
 // orientation, the near plane, thread-count independence, bad input, and the whole frame
 // against the GL view pass.
+#define GL_GLEXT_PROTOTYPES 1  // glGenFramebuffers & co. for the viewer-path test
+#include <GL/gl.h>
+#include <GL/glext.h>
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
@@ -189,7 +192,7 @@ TEST(SplatView, EmptyTextureMarginsAreSkippedWithoutChangingPixels) {
   const SplatAlphaTexture alpha(img);
   Buffers b;
   ViewSplatParticle p = particle(Vec3(1, 1, 1), 1);
-  p.half_w = 5.0 / 32;  // 10 px for 8 texels: samples fall between texel centres
+  p.half_w = 5.0 / 32;   // 10 px for 8 texels: samples fall between texel centres
   p.half_l = 11.0 / 32;  // 22 px for 16 texels
   splat_view_pass_bando2003(ortho(), std::vector<ViewSplatParticle>{p}, identity_order(1), tex,
                             b.target());
@@ -387,4 +390,55 @@ TEST_F(SplatViewGl, CpuViewPassMatchesTheGlViewPass) {
   EXPECT_GT(hair, n / 5);       // the hair covers a good part of the frame
   EXPECT_LT(diff / n, 1.0);     // mean max-channel difference below one 8-bit step
   EXPECT_LT(far_off, n / 500);  // a few edge pixels (mip level per quad vs per billboard)
+}
+
+TEST_F(SplatViewGl, ViewerPathMatchesTheImagePath) {
+  // render() resolves the read-back frame on the CPU; render_to_framebuffer() (the viewer)
+  // uploads the hair rectangle again and resolves with GL. Same picture within rounding (the
+  // upload rounds the blended floats to half floats once more).
+  const RenderScene s = make_hair_sheet_scene(1500);
+  RenderSettings rs;
+  rs.width = 160;
+  rs.height = 128;
+  rs.supersample = 2;
+  rs.shadow_map_size = 1024;
+  rs.hair_light_map_size = 256;
+  const auto img = renderer().render(s, rs);  // makes the renderer's context current
+  GLuint tex = 0, fbo = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rs.width, rs.height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+               nullptr);
+  glGenFramebuffers(1, &fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+  ASSERT_EQ(glCheckFramebufferStatus(GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
+  renderer().render_to_framebuffer(s, rs, fbo);
+  std::vector<uint8_t> px(4 * std::size_t(rs.width) * std::size_t(rs.height));
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, rs.width, rs.height, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteTextures(1, &tex);
+  int worst = 0, differ = 0;
+  for (int y = 0; y < rs.height; ++y)
+    for (int x = 0; x < rs.width; ++x)
+      for (int c = 0; c < 4; ++c) {
+        // GL rows are bottom-up, image rows top-down.
+        const int a = px[4 * (std::size_t(rs.height - 1 - y) * std::size_t(rs.width) + x) + c];
+        const int d = std::abs(a - int(img.at(x, y, c)));
+        worst = std::max(worst, d);
+        differ += d > 0;
+      }
+  EXPECT_LE(worst, 2);
+  EXPECT_LT(differ, rs.width * rs.height / 10);
+  // and the hair is there: the two paths are not both empty
+  RenderScene bare = s;
+  bare.particles.clear();
+  const auto head = renderer().render(bare, rs);
+  int hair = 0;
+  for (int y = 0; y < rs.height; ++y)
+    for (int x = 0; x < rs.width; ++x) hair += img.at(x, y, 0) != head.at(x, y, 0);
+  EXPECT_GT(hair, rs.width * rs.height / 6);
 }
