@@ -233,7 +233,8 @@ inline void store4(float* p, V4 v) {
   std::memcpy(p, &v, sizeof v);
 }
 
-/// Rows [y0, y1) of the target: every billboard in order, clipped to those rows.
+/// Rows [y0, y1) of the target: the billboards of `order` (those touching the rows, back to
+/// front), clipped to those rows.
 void splat_rows(const std::vector<Setup>& setups, std::span<const int32_t> order,
                 const SplatColorTexture& tex, const SplatViewTarget& tg, int y0, int y1) {
   const int stride_px = tg.rgba_stride > 0 ? tg.rgba_stride : tg.width;
@@ -426,13 +427,22 @@ void splat_view_pass_bando2003(const SplatViewParams& params,
                         setups[i] =
                             make_setup(params, particles[i], texture, tg.fb_width, tg.fb_height);
                     });
-  // Lines 19-21 per band of rows; every band sees the billboards in the same order.
+  // Lines 19-21 per band of rows; every band sees its billboards in the draw order. The lists
+  // per band (built in order, sequentially) spare each band a walk over all billboards.
   const int bands = (tg.height + kBandRows - 1) / kBandRows;
+  std::vector<std::vector<int32_t>> in_band{std::size_t(bands)};
+  for (const int32_t idx : order) {
+    const Setup& st = setups[std::size_t(idx)];
+    if (!st.visible || st.by1 <= tg.y0 || st.by0 >= tg.y0 + tg.height) continue;
+    const int b0 = std::max(0, (st.by0 - tg.y0) / kBandRows);
+    const int b1 = std::min(bands - 1, (st.by1 - 1 - tg.y0) / kBandRows);
+    for (int b = b0; b <= b1; ++b) in_band[std::size_t(b)].push_back(idx);
+  }
   tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& r) {
     for (int band = r.begin(); band != r.end(); ++band) {
       const int y0 = tg.y0 + band * kBandRows;
       const int y1 = std::min(tg.y0 + tg.height, y0 + kBandRows);
-      splat_rows(setups, order, texture, tg, y0, y1);
+      splat_rows(setups, in_band[std::size_t(band)], texture, tg, y0, y1);
     }
   });
 }
