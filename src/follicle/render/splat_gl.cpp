@@ -74,6 +74,18 @@ GLuint make_fbo(GLuint color_tex, const char* what) {
   return f;
 }
 
+/// The billboard of a particle record (16 floats, see shaders_splat_gl.hpp) into a particle of
+/// a CPU pass (LightSplatParticle or ViewSplatParticle).
+template <class P>
+void billboard_from_record(const float* r, P& p) {
+  p.pos = Vec3(r[0], r[1], r[2]);
+  p.half_w = r[3];
+  p.t = Vec3(r[4], r[5], r[6]);
+  p.half_l = r[7];
+  p.alpha = r[11];
+  p.min_sin = r[12];
+}
+
 std::string stage(const char* a, const char* b, const char* c = "") {
   return std::string(a) + b + c;
 }
@@ -305,12 +317,7 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
   for (std::size_t i = 0; i < n; ++i) {
     const float* r = &m_data[16 * i];
     LightSplatParticle& p = m_cpu_particles[i];
-    p.pos = Vec3(r[0], r[1], r[2]);
-    p.half_w = r[3];
-    p.t = Vec3(r[4], r[5], r[6]);
-    p.half_l = r[7];
-    p.alpha = r[11];
-    p.min_sin = r[12];
+    billboard_from_record(r, p);
     p.casts = r[13] > 0.5f;
     p.opacity_scale = m_items[std::size_t(r[15] + 0.5f)].item->splat.shadow_opacity_scale;
     p.vis = 1;
@@ -544,12 +551,7 @@ void SplatPassGl::view_pass_cpu(const RenderScene& scene, const Mat4& view, cons
       for (std::size_t i = b; i < e; ++i) {
         const float* r = &m_data[16 * i];
         ViewSplatParticle& p = m_view_particles[i];
-        p.pos = Vec3(r[0], r[1], r[2]);
-        p.half_w = r[3];
-        p.t = Vec3(r[4], r[5], r[6]);
-        p.half_l = r[7];
-        p.alpha = r[11];
-        p.min_sin = r[12];
+        billboard_from_record(r, p);
         const Vec3 c(r[8], r[9], r[10]);
         const SplatMaterial& m = m_items[std::size_t(r[15] + 0.5f)].item->splat;
         const Vec3 to_eye = (eye - p.pos).normalized();
