@@ -42,9 +42,14 @@ float half_bits_to_float(uint16_t h) {
   return (h & 0x8000) ? -mag : mag;
 }
 
-CpuResolve::CpuResolve() : m_srgb(kTable + 2), m_half(65536) {
-  for (int i = 0; i <= kTable; ++i) m_srgb[std::size_t(i)] = float(srgb_encode(double(i) / kTable));
-  m_srgb[kTable + 1] = m_srgb[kTable];
+CpuResolve::CpuResolve() : m_srgb(2 * (kTable + 1)), m_half(65536) {
+  // (value, slope) per interval in 8-bit units, the rounding's + 1/2 folded into the value.
+  for (int i = 0; i <= kTable; ++i) {
+    const double a = srgb_encode(double(i) / kTable);
+    const double b = i < kTable ? srgb_encode(double(i + 1) / kTable) : a;
+    m_srgb[2 * std::size_t(i)] = float(255 * a + 0.5);
+    m_srgb[2 * std::size_t(i) + 1] = float(255 * (b - a));
+  }
   for (uint32_t h = 0; h < 65536; ++h) m_half[h] = half_bits_to_float(uint16_t(h));
 }
 
@@ -66,7 +71,7 @@ void CpuResolve::resolve(const float* rgba, int fb_w, int fb_h, int k, bool unpr
   if (!rgba || out.empty() || fb_w != k * out.width() || fb_h != k * out.height())
     fail("resolve: a {}x{} frame does not resolve {}x down to {}x{}", fb_w, fb_h, k, out.width(),
          out.height());
-  const std::vector<float>& table = m_srgb;
+  const float* table = m_srgb.data();
   const int w = out.width(), h = out.height();
   const float inv_n = 1.0f / float(k * k);
   // One output pixel from its averaged linear RGBA.
@@ -76,9 +81,8 @@ void CpuResolve::resolve(const float* rgba, int fb_w, int fb_h, int k, bool unpr
       if (unpremultiply) v = s[3] > 0 ? v / s[3] : 0.0f;
       const float t = unit(v) * float(kTable);
       const int i = int(t);
-      const float e = table[std::size_t(i)] +
-                      (t - float(i)) * (table[std::size_t(i) + 1] - table[std::size_t(i)]);
-      d[c] = unorm8(e);
+      const float* e = table + 2 * i;
+      d[c] = uint8_t(int(e[0] + (t - float(i)) * e[1]));
     }
     d[3] = unorm8(s[3]);
   };

@@ -26,7 +26,7 @@ class CpuResolve {
   void half_to_float(const uint16_t* src, std::size_t n, float* dst) const;
 
  private:
-  std::vector<float> m_srgb;  // the sRGB curve at kTable + 1 points (+ 1 guard)
+  std::vector<float> m_srgb;  // the sRGB curve: (255 value + 1/2, 255 slope) per table interval
   std::vector<float> m_half;  // the value of every half-float bit pattern
 };
 

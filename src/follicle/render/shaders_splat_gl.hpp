@@ -77,6 +77,7 @@ uniform sampler2D uLightBuf;
 uniform float uShadowTexel;
 uniform float uShadowBias;
 uniform int uIntensityHeight;
+uniform bool uVisibilityOnly;  // the "cpu" light pass reads the hair light itself: skip it here
 flat out vec2 vValue;
 
 float light_buffer(vec3 w) {
@@ -102,6 +103,10 @@ void main() {
       for (int k = 0; k < 2; ++k)
         vis += 0.25 * texture(uShadowTex, vec3(s.xy + (vec2(k, j) - 0.5) * uShadowTexel,
                                                s.z - uShadowBias));
+  }
+  if (uVisibilityOnly) {
+    vValue = vec2(vis, 1.0);
+    return;
   }
   vec3 along, across;
   float sn;

@@ -351,6 +351,7 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
   gl::set_f(m_gather_prog, "uShadowTexel", light.shadow_texel);
   gl::set_f(m_gather_prog, "uShadowBias", light.shadow_bias);
   gl::set_i(m_gather_prog, "uIntensityHeight", m_intensity_h);
+  gl::set_i(m_gather_prog, "uVisibilityOnly", settings.hair_light_pass == "gpu" ? 0 : 1);
 
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_FALSE);
@@ -369,8 +370,8 @@ void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings,
 
 void SplatPassGl::light_exact_cpu(const Light& light, tbb::task_arena& arena) {
   const std::size_t n = m_count;
-  // Line 8's test, for all particles at once: the gather program's objects' visibility (its
-  // hair-light value reads a stale buffer and is not used).
+  // Line 8's test, for all particles at once: the gather program's objects' visibility (with
+  // uVisibilityOnly it skips the hair-light taps, which the CPU loop below computes).
   glBindFramebuffer(GL_FRAMEBUFFER, m_intensity_fbo);
   glViewport(0, 0, m_intensity_w, m_intensity_h);
   glDisable(GL_BLEND);
@@ -604,6 +605,7 @@ void SplatPassGl::view_pass_cpu(const RenderScene& scene, const Mat4& view, cons
   glBindTexture(GL_TEXTURE_2D, color_tex);
   glTexSubImage2D(GL_TEXTURE_2D, 0, tg.x0, tg.y0, tg.width, tg.height, GL_RGBA, GL_FLOAT,
                   m_view_rgba.data());
+  glBindTexture(GL_TEXTURE_2D, 0);  // the framebuffer's own attachment: leave no unit sampling it
   check_gl("hair view pass upload");
 }
 
