@@ -309,7 +309,7 @@ void SplatPassGl::bind_common(GLuint prog, int order_base) {
 void SplatPassGl::light_pass(const Light& light, const RenderSettings& settings, GLuint empty_vao,
                              tbb::task_arena& arena) {
   m_light_done = false;
-  m_intensity.clear();
+  m_intensity_on_cpu = false;
   if (m_count == 0) return;
   settings.validate();
   const std::size_t n = m_count;
@@ -399,7 +399,7 @@ void SplatPassGl::light_exact_cpu(const Light& light, tbb::task_arena& arena) {
   // The view pass reads (visibility, light through the hair) per particle (line 20), the
   // meshes the light map (line 16).
   for (std::size_t i = 0; i < n; ++i) m_staging[2 * i + 1] = m_cpu_result.reach[i];
-  m_intensity.assign(m_staging.begin(), m_staging.begin() + std::ptrdiff_t(2 * n));
+  m_intensity_on_cpu = true;
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glActiveTexture(GL_TEXTURE0 + kUnitIntensity);
   glBindTexture(GL_TEXTURE_2D, m_intensity_tex);
@@ -524,7 +524,7 @@ void SplatPassGl::view_pass_cpu(const RenderScene& scene, const Mat4& view, cons
     fail("render: the read-back frame has {} floats for {}x{} pixels", frame->size(), fb_w, fb_h);
   if (m_count == 0) return;
   const std::size_t n = m_count;
-  if (m_light_done && m_intensity.empty()) {  // the "gpu" light pass: read its intensities
+  if (m_light_done && !m_intensity_on_cpu) {  // the "gpu" light pass: read its intensities
     const int w = m_intensity_w;
     const int rows = int((n + std::size_t(w) - 1) / std::size_t(w));
     m_staging.assign(2 * std::size_t(w) * std::size_t(rows), 0.0f);
@@ -534,7 +534,7 @@ void SplatPassGl::view_pass_cpu(const RenderScene& scene, const Mat4& view, cons
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, w, rows, GL_RG, GL_FLOAT, m_staging.data());
     glBindFramebuffer(GL_FRAMEBUFFER, GLuint(prev));
-    m_intensity.assign(m_staging.begin(), m_staging.begin() + std::ptrdiff_t(2 * n));
+    m_intensity_on_cpu = true;
   }
   // Line 20's colour, per particle as kSplatViewVs computes it.
   const int nl = int(std::min<std::size_t>(scene.lights.size(), kMaxLights));
@@ -557,7 +557,7 @@ void SplatPassGl::view_pass_cpu(const RenderScene& scene, const Mat4& view, cons
         const SplatMaterial& m = m_items[std::size_t(r[15] + 0.5f)].item->splat;
         const Vec3 to_eye = (eye - p.pos).normalized();
         double att = 1;
-        if (m_light_done) att = m_intensity[2 * i] * (r[14] > 0.5f ? m_intensity[2 * i + 1] : 1.0f);
+        if (m_light_done) att = m_staging[2 * i] * (r[14] > 0.5f ? m_staging[2 * i + 1] : 1.0f);
         Vec3 col = c.cwiseProduct(m.ambient * scene.ambient_color);
         for (int j = 0; j < nl; ++j) {
           const DirectionalLight& l = scene.lights[std::size_t(j)];

@@ -109,12 +109,13 @@ class SplatPassGl {
   std::shared_ptr<const image::ImageRGBA8> m_cpu_custom_src;
   SplatLightResult m_cpu_result;
   std::vector<float> m_staging;
-  // The "cpu" view pass: the hair texture's RGBA mip chains, the particles, the per-particle
-  // (visibility, light through the hair) of the light pass and the read-back window.
+  // The "cpu" view pass: the hair texture's RGBA mip chains, the particles and the read-back
+  // window.
   std::unique_ptr<SplatColorTexture> m_cpu_default_color, m_cpu_custom_color;
   std::shared_ptr<const image::ImageRGBA8> m_cpu_custom_color_src;
   std::vector<ViewSplatParticle> m_view_particles;
-  std::vector<float> m_intensity;  // 2 per particle, valid when m_light_done
+  // (visibility, light through the hair) per particle are in m_staging[2i], m_staging[2i + 1]
+  bool m_intensity_on_cpu = false;
   std::vector<float> m_view_rgba, m_view_depth;
 };
 

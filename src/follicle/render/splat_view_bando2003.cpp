@@ -330,18 +330,22 @@ SplatColorTexture::SplatColorTexture(const image::ImageRGBA8& img) : m_alpha(non
   for (int l = 0; l < m_alpha.levels(); ++l)
     m_rgba[std::size_t(l)].assign(
         4 * std::size_t(m_alpha.width(l) + 2) * std::size_t(m_alpha.height(l) + 2), 0.0f);
-  // Channel c's chain is SplatAlphaTexture's of an image whose alpha is channel c.
-  image::ImageRGBA8 ch(img.width(), img.height());
-  for (int c = 0; c < 4; ++c) {
-    for (int y = 0; y < img.height(); ++y)
-      for (int x = 0; x < img.width(); ++x) ch.at(x, y, 3) = img.at(x, y, c);
-    const SplatAlphaTexture chain(ch);
+  // Channel c's chain is SplatAlphaTexture's of an image whose alpha is channel c; alpha's is
+  // m_alpha.
+  auto put = [&](int c, const SplatAlphaTexture& chain) {
     for (int l = 0; l < chain.levels(); ++l) {
       const float* src = chain.padded(l);
       std::vector<float>& dst = m_rgba[std::size_t(l)];
       for (std::size_t i = 0; i < dst.size() / 4; ++i) dst[4 * i + std::size_t(c)] = src[i];
     }
+  };
+  image::ImageRGBA8 ch(img.width(), img.height());
+  for (int c = 0; c < 3; ++c) {
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x) ch.at(x, y, 3) = img.at(x, y, c);
+    put(c, SplatAlphaTexture(ch));
   }
+  put(3, m_alpha);
   for (int l = 0; l < levels(); ++l) {
     const int w = width(l), h = height(l);
     std::array<int, 4> box = {w, -1, h, -1};
