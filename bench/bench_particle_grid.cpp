@@ -45,6 +45,34 @@ void BM_ParticleGridNeighbourLists(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(x.size()));
 }
 
+void BM_ParticleGridNeighbourListsPlain(benchmark::State& state) {
+  // The same with the plain distance loop instead of the SIMD one (identical lists).
+  Context ctx(int(state.range(0)));
+  const auto x = lattice(50, 20, 100, 7);
+  hair::ParticleGrid grid;
+  grid.set_simd(false);
+  std::vector<uint32_t> off, nb;
+  for (auto _ : state) {
+    grid.build(x, kRadius);
+    grid.neighbour_lists(ctx, x, kRadius, off, nb);
+    benchmark::DoNotOptimize(nb.data());
+  }
+}
+
+void BM_ParticleGridRebuild(benchmark::State& state) {
+  // The whole neighbour rebuild of LcpSolver::rebuild_neighbours: grid, lists, sort and mirror.
+  Context ctx(int(state.range(0)));
+  const auto x = lattice(50, 20, 100, 7);
+  hair::ParticleGrid grid;
+  std::vector<uint32_t> off, nb, mirror;
+  for (auto _ : state) {
+    grid.build(x, kRadius);
+    grid.neighbour_lists(ctx, x, kRadius, off, nb);
+    if (!hair::sort_and_mirror(ctx, off, nb, mirror)) state.SkipWithError("asymmetric lists");
+    benchmark::DoNotOptimize(mirror.data());
+  }
+}
+
 void BM_ParticleGridCrossLists(benchmark::State& state) {
   // 25,000 air particles (spacing 2.5 a) querying the hair grid, as in the SPH air coupling.
   Context ctx(int(state.range(0)));
@@ -89,6 +117,12 @@ BENCHMARK(BM_ParticleGridNeighbourLists)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_ParticleGridNeighbourListsPlain)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_ParticleGridRebuild)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ParticleGridCrossLists)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ParticleGridSortAndMirror)
     ->Arg(1)

@@ -1,6 +1,9 @@
 #include "follicle/hair/particle_grid.hpp"
 
 #include <algorithm>
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -18,17 +21,79 @@ void CellTable::build(const Context* ctx, const std::vector<Vec3>& points, doubl
   const bool par = ctx && ctx->threads() > 1 && n >= 4096;
   bucket_of.resize(n);
   cell_of.resize(n);
-  auto cell_and_bucket = [&](std::size_t i) {
+  auto cell = [&](std::size_t i) {
     const Vec3& p = points[i];
-    const std::array<int, 3> c{int(std::floor(p.x() * inv)), int(std::floor(p.y() * inv)),
-                               int(std::floor(p.z() * inv))};
-    cell_of[i] = c;
-    bucket_of[i] = bucket(c[0], c[1], c[2]);
+    cell_of[i] = {int(std::floor(p.x() * inv)), int(std::floor(p.y() * inv)),
+                  int(std::floor(p.z() * inv))};
   };
   if (par)
-    parallel_for(*ctx, 0, n, cell_and_bucket, 2048);
+    parallel_for(*ctx, 0, n, cell, 2048);
   else
-    for (std::size_t i = 0; i < n; ++i) cell_and_bucket(i);
+    for (std::size_t i = 0; i < n; ++i) cell(i);
+  // The box of the occupied cells decides the layout (dense when it has at most nb cells).
+  dense = false;
+  if (n > 0) {
+    std::array<int, 3> mn = cell_of[0], mx = cell_of[0];
+    for (std::size_t i = 1; i < n; ++i)
+      for (int a = 0; a < 3; ++a) {
+        mn[a] = std::min(mn[a], cell_of[i][a]);
+        mx[a] = std::max(mx[a], cell_of[i][a]);
+      }
+    int64_t cells = 1;
+    dense = true;
+    for (int a = 0; a < 3 && dense; ++a) {
+      const int64_t d = int64_t(mx[a]) - int64_t(mn[a]) + 1;
+      dense = d <= int64_t(nb) && cells * d <= int64_t(nb);
+      cells *= d;
+      dim[a] = int(d);
+    }
+    lo = mn;
+  }
+  if (dense) {
+    // Counting sort by cell, stable by index; the cells are the table entries.
+    const std::size_t ncells = std::size_t(dim[0]) * std::size_t(dim[1]) * std::size_t(dim[2]);
+    auto id = [&](std::size_t i) {
+      const auto& c = cell_of[i];
+      bucket_of[i] =
+          uint32_t((std::size_t(c[2] - lo[2]) * std::size_t(dim[1]) + std::size_t(c[1] - lo[1])) *
+                       std::size_t(dim[0]) +
+                   std::size_t(c[0] - lo[0]));
+    };
+    if (par)
+      parallel_for(*ctx, 0, n, id, 4096);
+    else
+      for (std::size_t i = 0; i < n; ++i) id(i);
+    bucket_cells.clear();
+    cell_key.clear();
+    cell_start.assign(ncells + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) ++cell_start[bucket_of[i] + 1];
+    for (std::size_t c = 0; c < ncells; ++c) cell_start[c + 1] += cell_start[c];
+    fill.assign(cell_start.begin(), cell_start.end() - 1);
+    sorted.resize(n);
+    for (std::size_t i = 0; i < n; ++i) sorted[fill[bucket_of[i]]++] = uint32_t(i);
+  } else {
+    build_hashed(n, nb);
+  }
+  x.resize(n);
+  y.resize(n);
+  z.resize(n);
+  auto copy = [&](std::size_t s) {
+    const Vec3& p = points[sorted[s]];
+    x[s] = p.x();
+    y[s] = p.y();
+    z[s] = p.z();
+  };
+  if (par)
+    parallel_for(*ctx, 0, n, copy, 4096);
+  else
+    for (std::size_t s = 0; s < n; ++s) copy(s);
+}
+
+void CellTable::build_hashed(std::size_t n, std::size_t nb) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& c = cell_of[i];
+    bucket_of[i] = bucket(c[0], c[1], c[2]);
+  }
   // Counting sort by bucket, stable by index.
   start.assign(nb + 1, 0);
   for (std::size_t i = 0; i < n; ++i) ++start[bucket_of[i] + 1];
@@ -77,19 +142,6 @@ void CellTable::build(const Context* ctx, const std::vector<Vec3>& points, doubl
   }
   bucket_cells[nb] = uint32_t(cell_key.size());
   cell_start.push_back(uint32_t(n));
-  x.resize(n);
-  y.resize(n);
-  z.resize(n);
-  auto copy = [&](std::size_t s) {
-    const Vec3& p = points[sorted[s]];
-    x[s] = p.x();
-    y[s] = p.y();
-    z[s] = p.z();
-  };
-  if (par)
-    parallel_for(*ctx, 0, n, copy, 4096);
-  else
-    for (std::size_t s = 0; s < n; ++s) copy(s);
 }
 
 }  // namespace detail
@@ -151,14 +203,120 @@ bool same_points(const Context& ctx, const detail::CellTable& t, const std::vect
 }
 }  // namespace
 
+namespace {
+/// A run of consecutive slots to scan.
+struct Range {
+  uint32_t s0, s1;
+};
+
+/// The distance test over the slots of `rg`, in order: writes the index of every slot t with
+/// (x_t - p)^2 < r2 (squared norm summed as (dx^2 + dy^2) + dz^2, the arithmetic of
+/// Vec3::squaredNorm) and index != self to o, returns the count. Plain loop, branch-free.
+uint32_t filter_plain(const detail::CellTable& g, const Range* rg, std::size_t nr, double px,
+                      double py, double pz, double r2, uint32_t self, uint32_t* __restrict o) {
+  const double* __restrict cx = g.x.data();
+  const double* __restrict cy = g.y.data();
+  const double* __restrict cz = g.z.data();
+  const uint32_t* __restrict ci = g.sorted.data();
+  uint32_t cnt = 0;
+  for (std::size_t k = 0; k < nr; ++k)
+    for (uint32_t t = rg[k].s0; t < rg[k].s1; ++t) {
+      const double ex = cx[t] - px, ey = cy[t] - py, ez = cz[t] - pz;
+      const double d2 = ex * ex + ey * ey + ez * ez;
+      o[cnt] = ci[t];
+      cnt += uint32_t((d2 < r2) & (ci[t] != self));
+    }
+  return cnt;
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FOLLICLE_GRID_AVX2 1
+/// Byte shuffles that move the selected 32-bit lanes of a 4-lane mask to the front, in order.
+struct CompactTable {
+  alignas(16) uint8_t shuf[16][16];
+  uint8_t count[16];
+};
+constexpr CompactTable make_compact_table() {
+  CompactTable t{};
+  for (int m = 0; m < 16; ++m) {
+    int w = 0;
+    for (int lane = 0; lane < 4; ++lane)
+      if (m & (1 << lane)) {
+        for (int b = 0; b < 4; ++b) t.shuf[m][4 * w + b] = uint8_t(4 * lane + b);
+        ++w;
+      }
+    for (int b = 4 * w; b < 16; ++b) t.shuf[m][b] = 0x80;  // zero the rest
+    t.count[m] = uint8_t(w);
+  }
+  return t;
+}
+constexpr CompactTable kCompact = make_compact_table();
+
+/// filter_plain with AVX2: four candidates per step (the same IEEE operations per lane, no FMA,
+/// so the same decisions), a lane mask compacted by a byte shuffle and stored unaligned (o must
+/// have room for 4 entries past the count). The last 1-3 slots of a range are read by masked
+/// loads.
+#pragma GCC push_options
+#pragma GCC target("avx2")
+uint32_t filter_avx2(const detail::CellTable& g, const Range* rg, std::size_t nr, double px,
+                     double py, double pz, double r2, uint32_t self, uint32_t* __restrict o) {
+  const double* cx = g.x.data();
+  const double* cy = g.y.data();
+  const double* cz = g.z.data();
+  const uint32_t* ci = g.sorted.data();
+  const __m256d vx = _mm256_set1_pd(px), vy = _mm256_set1_pd(py), vz = _mm256_set1_pd(pz);
+  const __m256d vr2 = _mm256_set1_pd(r2);
+  const __m128i vself = _mm_set1_epi32(int(self));
+  uint32_t cnt = 0;
+  auto step = [&](__m256d X, __m256d Y, __m256d Z, __m128i id, int valid) {
+    const __m256d ex = _mm256_sub_pd(X, vx), ey = _mm256_sub_pd(Y, vy), ez = _mm256_sub_pd(Z, vz);
+    const __m256d d2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey)),
+                                     _mm256_mul_pd(ez, ez));
+    int m = _mm256_movemask_pd(_mm256_cmp_pd(d2, vr2, _CMP_LT_OQ));
+    m &= ~_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(id, vself))) & valid;
+    const __m128i sh = _mm_load_si128(reinterpret_cast<const __m128i*>(kCompact.shuf[m]));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(o + cnt), _mm_shuffle_epi8(id, sh));
+    cnt += kCompact.count[m];
+  };
+  for (std::size_t k = 0; k < nr; ++k) {
+    uint32_t t = rg[k].s0;
+    const uint32_t s1 = rg[k].s1;
+    for (; t + 4 <= s1; t += 4)
+      step(_mm256_loadu_pd(cx + t), _mm256_loadu_pd(cy + t), _mm256_loadu_pd(cz + t),
+           _mm_loadu_si128(reinterpret_cast<const __m128i*>(ci + t)), 15);
+    if (t < s1) {
+      const int rest = int(s1 - t);  // 1..3
+      const __m128i l32 = _mm_cmpgt_epi32(_mm_set1_epi32(rest), _mm_setr_epi32(0, 1, 2, 3));
+      const __m256i l64 = _mm256_cvtepi32_epi64(l32);
+      step(_mm256_maskload_pd(cx + t, l64), _mm256_maskload_pd(cy + t, l64),
+           _mm256_maskload_pd(cz + t, l64),
+           _mm_maskload_epi32(reinterpret_cast<const int*>(ci + t), l32), (1 << rest) - 1);
+    }
+  }
+  return cnt;
+}
+#pragma GCC pop_options
+#endif
+
+bool have_avx2() {
+#ifdef FOLLICLE_GRID_AVX2
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
+#else
+  return false;
+#endif
+}
+}  // namespace
+
 void ParticleGrid::cell_lists(const Context& ctx, const detail::CellTable& q,
                               const std::vector<Vec3>& qpts, bool self, double r2,
                               std::vector<uint32_t>& offsets, std::vector<uint32_t>& nbrs) const {
-  // Query points are processed cell by cell: the 27 cells around a query cell are looked up once
-  // and their points gathered into a contiguous scratch, which every query of the cell scans in
-  // order. A query's list is thus the for_each_candidate order filtered by distance.
+  // Query points are processed cell by cell: the cells around a query cell are looked up once,
+  // then each query of the cell scans their slots (in (dz, dy, dx) order, each cell's points by
+  // index) through the distance test. A query's list is thus the for_each_candidate order
+  // filtered by distance. In a dense table a row of three cells in x is one run of slots.
   const std::size_t n = qpts.size();
-  const std::size_t ncells = q.cell_key.size();
+  const std::size_t ncells = q.cells();
   constexpr std::size_t kMaxParts = 128;
   const std::size_t per = std::max<std::size_t>(1, (ncells + kMaxParts - 1) / kMaxParts);
   const std::size_t nparts = (ncells + per - 1) / per;
@@ -167,6 +325,7 @@ void ParticleGrid::cell_lists(const Context& ctx, const detail::CellTable& q,
   m_pos_of.resize(n);
   offsets.assign(n + 1, 0);
   const detail::CellTable& g = m_cells;
+  const bool simd = m_simd && have_avx2();
   // Skip threshold of the cell boxes in cell units: (r / cell)^2 plus a margin of 1e-6.
   const double r2_cells = r2 * g.inv * g.inv * (1 + 1e-6) + 1e-6;
   parallel_for(
@@ -177,61 +336,78 @@ void ParticleGrid::cell_lists(const Context& ctx, const detail::CellTable& q,
         std::size_t used = 0;
         const std::size_t c1 = std::min(ncells, (part + 1) * per);
         for (std::size_t qc = part * per; qc < c1; ++qc) {
-          // The occupied cells among the 27 around the query cell, in (dz, dy, dx) order.
-          const auto& key = q.cell_key[qc];
+          if (q.cell_start[qc] == q.cell_start[qc + 1]) continue;
+          const auto key = q.key(qc);
+          // The runs around the query cell, in (dz, dy, dx) order: a dense grid gives one run
+          // per row (cells dx = xa..xb of it, row id of dx = 0 in `base`), a hashed grid one
+          // run per occupied cell (xa = xb = its dx).
           struct Seg {
-            uint32_t s0, s1;
-            int dx, dy, dz;
+            int64_t base;
+            int xa, xb, dy, dz;
           };
           std::array<Seg, 27> segs;
           std::size_t nseg = 0, k = 0;
-          for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-              for (int dx = -1; dx <= 1; ++dx) {
-                const int64_t c = g.find(key[0] + dx, key[1] + dy, key[2] + dz);
-                if (c < 0) continue;
-                segs[nseg++] = {g.cell_start[c], g.cell_start[c + 1], dx + 1, dy + 1, dz + 1};
-                k += g.cell_start[c + 1] - g.cell_start[c];
+          if (g.dense) {
+            const int xa = std::max(-1, g.lo[0] - key[0]);
+            const int xb = std::min(1, g.lo[0] + g.dim[0] - 1 - key[0]);
+            for (int dz = -1; dz <= 1; ++dz)
+              for (int dy = -1; dy <= 1; ++dy) {
+                const int64_t iy = int64_t(key[1]) + dy - g.lo[1];
+                const int64_t iz = int64_t(key[2]) + dz - g.lo[2];
+                if (xa > xb || iy < 0 || iz < 0 || iy >= g.dim[1] || iz >= g.dim[2]) continue;
+                const int64_t base = (iz * g.dim[1] + iy) * g.dim[0] + (int64_t(key[0]) - g.lo[0]);
+                const uint32_t s0 = g.cell_start[std::size_t(base + xa)];
+                const uint32_t s1 = g.cell_start[std::size_t(base + xb + 1)];
+                if (s0 == s1) continue;
+                segs[nseg++] = {base, xa, xb, dy + 1, dz + 1};
+                k += s1 - s0;
               }
-          const double* __restrict cx = g.x.data();
-          const double* __restrict cy = g.y.data();
-          const double* __restrict cz = g.z.data();
-          const uint32_t* __restrict ci = g.sorted.data();
+          } else {
+            for (int dz = -1; dz <= 1; ++dz)
+              for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                  const int64_t c = g.find(key[0] + dx, key[1] + dy, key[2] + dz);
+                  if (c < 0) continue;
+                  segs[nseg++] = {c - dx, dx, dx, dy + 1, dz + 1};
+                  k += g.cell_start[std::size_t(c) + 1] - g.cell_start[std::size_t(c)];
+                }
+          }
           for (uint32_t s = q.cell_start[qc]; s < q.cell_start[qc + 1]; ++s) {
             const uint32_t i = q.sorted[s];
             const double px = q.x[s], py = q.y[s], pz = q.z[s];
             const Vec3& p = qpts[i];
             P.mismatch |= !(p.x() == px && p.y() == py && p.z() == pz);
-            if (P.out.size() < used + k) P.out.resize(std::max(2 * P.out.size(), used + k + 4096));
-            uint32_t* __restrict o = P.out.data() + used;
-            uint32_t cnt = 0;
+            if (P.out.size() < used + k + 4)
+              P.out.resize(std::max(2 * P.out.size(), used + k + 4096));
             // Squared distance (in cells) from the query to the box of each neighbour cell, per
             // axis: a cell whose box is farther than the radius (with a margin far above the
-            // rounding of the cell coordinates) holds no neighbour and is skipped.
+            // rounding of the cell coordinates) holds no neighbour and is skipped (a row keeps
+            // its cells within reach: the middle one whenever any is, as bx = 0 there).
             const double fx = px * g.inv - key[0], fy = py * g.inv - key[1],
                          fz = pz * g.inv - key[2];
             const double bx[3] = {fx * fx, 0.0, (1 - fx) * (1 - fx)};
             const double by[3] = {fy * fy, 0.0, (1 - fy) * (1 - fy)};
             const double bz[3] = {fz * fz, 0.0, (1 - fz) * (1 - fz)};
+            std::array<Range, 27> rg;
+            std::size_t nr = 0;
             for (std::size_t sg = 0; sg < nseg; ++sg) {
               const Seg& S = segs[sg];
-              if (bx[S.dx] + by[S.dy] + bz[S.dz] > r2_cells) continue;
-              // Same arithmetic as (x_j - p).squaredNorm() < r2: (dx^2 + dy^2) + dz^2.
-              if (self)
-                for (uint32_t t = S.s0; t < S.s1; ++t) {
-                  const double ex = cx[t] - px, ey = cy[t] - py, ez = cz[t] - pz;
-                  const double d2 = ex * ex + ey * ey + ez * ez;
-                  o[cnt] = ci[t];
-                  cnt += uint32_t((d2 < r2) & (ci[t] != i));
-                }
-              else
-                for (uint32_t t = S.s0; t < S.s1; ++t) {
-                  const double ex = cx[t] - px, ey = cy[t] - py, ez = cz[t] - pz;
-                  const double d2 = ex * ex + ey * ey + ez * ez;
-                  o[cnt] = ci[t];
-                  cnt += uint32_t(d2 < r2);
-                }
+              const double byz = by[S.dy] + bz[S.dz];
+              if (byz > r2_cells) continue;  // then the row's middle cell (bx = 0) is in reach
+              const int xa = std::max(S.xa, int(bx[0] + byz > r2_cells) - 1);
+              const int xb = std::min(S.xb, 1 - int(bx[2] + byz > r2_cells));
+              if (xa > xb) continue;
+              rg[nr++] = {g.cell_start[std::size_t(S.base + xa)],
+                          g.cell_start[std::size_t(S.base + xb + 1)]};
             }
+            const uint32_t me = self ? i : UINT32_MAX;
+            uint32_t* o = P.out.data() + used;
+#ifdef FOLLICLE_GRID_AVX2
+            const uint32_t cnt = simd ? filter_avx2(g, rg.data(), nr, px, py, pz, r2, me, o)
+                                      : filter_plain(g, rg.data(), nr, px, py, pz, r2, me, o);
+#else
+            const uint32_t cnt = filter_plain(g, rg.data(), nr, px, py, pz, r2, me, o);
+#endif
             m_part_of[i] = uint32_t(part);
             m_pos_of[i] = uint32_t(used);
             offsets[i + 1] = cnt;

@@ -2,11 +2,12 @@
 // Uniform-grid neighbour search for particles (Bando 2003 §3.3: "a grid of voxels of size 2h").
 // Hand-written rather than a general geom grid because the solvers need (a) neighbour lists in a
 // fixed order that does not depend on the thread count and (b) a rebuild every time step without
-// allocation. Cells are hashed into a table (2 x points, power of two); points are counting-sorted
-// by bucket, stably by index, and each bucket is split into its cells, so every occupied cell is
-// one contiguous run of slots holding its points in increasing index order. The candidate order
-// (the 27 cells around a point in z, y, x order, each cell's points by index) is therefore a pure
-// function of the positions and the cell size, independent of the hash and of the thread count.
+// allocation. Points are counting-sorted by cell, stably by index, so every occupied cell is one
+// contiguous run of slots holding its points in increasing index order. The cells are a dense
+// table over the box of occupied cells when that box is small (at most 2 x points cells, rounded
+// up to a power of two), else a hash table. The candidate order (the 27 cells around a point in
+// z, y, x order, each cell's points by index) is a pure function of the positions and the cell
+// size, independent of the layout, the hash and the thread count.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -18,21 +19,39 @@
 namespace follicle::hair {
 
 namespace detail {
-/// Points grouped by integer cell: bucket -> cells (hash collisions share a bucket), cell ->
-/// contiguous slots, slot -> point index (increasing within a cell) and position (SoA).
+/// Points grouped by integer cell: cell -> contiguous slots, slot -> point index (increasing
+/// within a cell) and position (SoA). Two layouts of the cells, chosen by the points alone:
+/// - dense: when the box of occupied cells has at most as many cells as the hash table would have
+///   buckets, every cell of the box is a table entry (empty ones included), numbered
+///   c = ((cz - lo_z) dim_y + (cy - lo_y)) dim_x + (cx - lo_x). Cells adjacent in x are then
+///   adjacent in the slots: the three cells dx = -1..1 of a row are one contiguous run, which the
+///   list build scans in one go.
+/// - hashed: bucket -> cells (hash collisions share a bucket), only occupied cells are entries.
 struct CellTable {
   double inv = 1.0;
-  uint32_t mask = 0;
-  std::vector<uint32_t> bucket_cells;            // bucket -> first cell, size buckets + 1
+  bool dense = false;
+  std::array<int, 3> lo{}, dim{};                // dense: first cell and cells per axis
+  uint32_t mask = 0;                             // hashed: buckets - 1
+  std::vector<uint32_t> bucket_cells;            // hashed: bucket -> first cell, buckets + 1
   std::vector<uint32_t> cell_start;              // cell -> first slot, size cells + 1
-  std::vector<std::array<int, 3>> cell_key;      // integer coordinates of each cell
+  std::vector<std::array<int, 3>> cell_key;      // hashed: integer coordinates of each cell
   std::vector<uint32_t> sorted;                  // point index of each slot
   std::vector<double> x, y, z;                   // position of each slot
   std::vector<uint32_t> start, fill, bucket_of;  // scratch of the build
   std::vector<std::array<int, 3>> cell_of, cell_sorted;
 
   void build(const Context* ctx, const std::vector<Vec3>& points, double inv_cell);
-  bool empty() const { return bucket_cells.empty(); }
+  void build_hashed(std::size_t n, std::size_t nb);
+  bool empty() const { return cell_start.empty(); }
+  /// Number of cell entries (dense: all cells of the box).
+  std::size_t cells() const { return cell_start.empty() ? 0 : cell_start.size() - 1; }
+  /// Integer coordinates of cell entry c.
+  std::array<int, 3> key(std::size_t c) const {
+    if (!dense) return cell_key[c];
+    const std::size_t row = c / std::size_t(dim[0]);
+    return {lo[0] + int(c % std::size_t(dim[0])), lo[1] + int(row % std::size_t(dim[1])),
+            lo[2] + int(row / std::size_t(dim[1]))};
+  }
   uint32_t bucket(int cx, int cy, int cz) const {
     uint64_t h = uint64_t(uint32_t(cx)) * 73856093ull ^ uint64_t(uint32_t(cy)) * 19349663ull ^
                  uint64_t(uint32_t(cz)) * 83492791ull;
@@ -40,6 +59,12 @@ struct CellTable {
   }
   /// The cell with these coordinates, or -1 when no point lies in it.
   int64_t find(int cx, int cy, int cz) const {
+    if (dense) {
+      const int64_t ix = int64_t(cx) - lo[0], iy = int64_t(cy) - lo[1], iz = int64_t(cz) - lo[2];
+      if (ix < 0 || iy < 0 || iz < 0 || ix >= dim[0] || iy >= dim[1] || iz >= dim[2]) return -1;
+      const int64_t c = (iz * dim[1] + iy) * dim[0] + ix;
+      return cell_start[std::size_t(c)] == cell_start[std::size_t(c) + 1] ? -1 : c;
+    }
     const uint32_t b = bucket(cx, cy, cz);
     for (uint32_t c = bucket_cells[b]; c < bucket_cells[b + 1]; ++c) {
       const auto& k = cell_key[c];
@@ -97,12 +122,19 @@ class ParticleGrid {
                    const std::vector<Vec3>& grid_points, double radius,
                    std::vector<uint32_t>& offsets, std::vector<uint32_t>& nbrs) const;
 
+  /// Whether the last build laid the cells out as a dense box (else hashed; see CellTable).
+  bool dense() const { return m_cells.dense; }
+  /// The list builds test distances with the SIMD kernel when the CPU has one (default) or with
+  /// the plain loop; the lists are identical (for tests and benchmarks).
+  void set_simd(bool on) { m_simd = on; }
+
  private:
   void cell_lists(const Context& ctx, const detail::CellTable& q, const std::vector<Vec3>& qpts,
                   bool self, double r2, std::vector<uint32_t>& offsets,
                   std::vector<uint32_t>& nbrs) const;
 
   detail::CellTable m_cells;
+  bool m_simd = true;
   mutable detail::CellTable m_query_cells;            // cross_lists: the query points by cell
   mutable std::vector<detail::ListPart> m_parts;      // per chunk of query cells
   mutable std::vector<uint32_t> m_part_of, m_pos_of;  // where each query's list was written

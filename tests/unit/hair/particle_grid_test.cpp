@@ -122,10 +122,25 @@ SerialAndParallel lists_1_and_2_threads(const std::vector<Vec3>& x, double cell,
   return r;
 }
 
+/// The lists of a grid whose distance test is the plain loop (set_simd(false)).
+void plain_lists(const std::vector<Vec3>& x, double cell, double radius, std::vector<uint32_t>& off,
+                 std::vector<uint32_t>& nb) {
+  Context ctx(2);
+  ParticleGrid grid;
+  grid.set_simd(false);
+  grid.build(ctx, x, cell);
+  grid.neighbour_lists(ctx, x, radius, off, nb);
+}
+
 void expect_neighbour_lists_match(const std::vector<Vec3>& x, double cell, double radius) {
   const auto [off1, nb1, off2, nb2] = lists_1_and_2_threads(x, cell, radius);
   const Lists got = from_csr(off1, nb1);
   EXPECT_EQ(got, ordered_reference(x, x, x, cell, radius, true));
+  // The plain distance loop and the SIMD one give the same lists.
+  std::vector<uint32_t> offp, nbp;
+  plain_lists(x, cell, radius, offp, nbp);
+  EXPECT_EQ(offp, off1);
+  EXPECT_EQ(nbp, nb1);
   if (radius <= cell) {
     EXPECT_EQ(sorted_lists(got), brute_force_sets(x, x, radius, true));
   }
@@ -153,7 +168,89 @@ TEST(ParticleGrid, RandomPointsMatchTheBruteForceInTheDocumentedOrder) {
 }
 
 TEST(ParticleGrid, ClusteredPointsMatchTheBruteForce) {
-  expect_neighbour_lists_match(clustered_points(1600, 2), 0.005, 0.005);
+  const auto x = clustered_points(1600, 2);
+  ParticleGrid grid;
+  grid.build(x, 0.005);
+  EXPECT_FALSE(grid.dense());  // sparse points far apart: the hashed cells
+  expect_neighbour_lists_match(x, 0.005, 0.005);
+}
+
+TEST(ParticleGrid, DenseAndHashedCellsGiveTheSameLists) {
+  // The same points with and without a far outlier: the first grid is a dense box of cells (rows
+  // of three cells scanned as one run), the second hashed (one run per cell). Lists of the
+  // common points must be identical, entry for entry, and the outlier has none. Densities from
+  // under one to dozens of points per cell give runs of every length modulo the SIMD width.
+  for (const double cell : {0.005, 0.008, 0.02}) {
+    const auto x = random_points(900, -0.03, 0.03, 31);
+    auto y = x;
+    y.push_back(Vec3(40.0, -25.0, 3.0));
+    ParticleGrid gx, gy;
+    gx.build(x, cell);
+    gy.build(y, cell);
+    EXPECT_TRUE(gx.dense());
+    EXPECT_FALSE(gy.dense());
+    Context ctx(2);
+    std::vector<uint32_t> offx, nbx, offy, nby;
+    gx.neighbour_lists(ctx, x, cell, offx, nbx);
+    gy.neighbour_lists(ctx, y, cell, offy, nby);
+    ASSERT_EQ(offy.size(), offx.size() + 1);
+    EXPECT_EQ(std::vector<uint32_t>(offy.begin(), offy.end() - 1), offx);
+    EXPECT_EQ(offy.back(), offx.back());
+    EXPECT_EQ(nby, nbx);
+    EXPECT_EQ(from_csr(offx, nbx), ordered_reference(x, x, x, cell, cell, true));
+    for (const bool simd : {true, false})
+      for (ParticleGrid* g : {&gx, &gy}) {
+        // Queries inside, around and outside the grid's box (the dense rows are clipped to the
+        // box), against the SIMD and the plain distance test.
+        const auto q = random_points(300, -0.06, 0.06, 32);
+        const auto& pts = g == &gx ? x : y;
+        std::vector<uint32_t> off, nb;
+        g->set_simd(simd);
+        g->cross_lists(ctx, q, pts, 0.8 * cell, off, nb);
+        EXPECT_EQ(from_csr(off, nb), ordered_reference(pts, pts, q, cell, 0.8 * cell, false))
+            << cell << " simd " << simd << " dense " << g->dense();
+      }
+  }
+}
+
+TEST(ParticleGrid, BoxesOneOrTwoCellsThickMatchTheBruteForce) {
+  // Dense boxes one or two cells thick in x, y or z: a row of cells clipped at the box's ends
+  // must not run into the neighbouring row (with one or two cells per row, that row holds
+  // true neighbours: they would appear twice or out of order).
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double thick : {0.6, 1.7}) {
+      auto x = random_points(600, -0.03, 0.03, 40 + uint64_t(axis));
+      for (auto& p : x) p[axis] = 0.01 * thick * (p[axis] + 0.03) / 0.06;
+      ParticleGrid grid;
+      grid.build(x, 0.01);
+      ASSERT_TRUE(grid.dense());
+      expect_neighbour_lists_match(x, 0.01, 0.01);
+    }
+}
+
+TEST(ParticleGrid, RunsOfEveryLengthModuloTheSimdWidth) {
+  // One row of points along x, k points per cell (k = 1..9), all at the same y and z: every run
+  // of a row has length 3k or 2k at the ends, so the vector loop ends with 0..3 leftover slots.
+  // All points lie within the radius of their cell neighbours except those two cells away.
+  for (int k = 1; k <= 9; ++k) {
+    const double cell = 0.01;
+    std::vector<Vec3> x;
+    for (int c = 0; c < 6; ++c)
+      for (int m = 0; m < k; ++m)
+        x.push_back(Vec3(cell * (c + (m + 0.5) / (k + 0.25)), 0.003 * (m % 3), 0.002));
+    ParticleGrid grid;
+    grid.build(x, cell);
+    ASSERT_TRUE(grid.dense());
+    Context ctx(1);
+    for (const bool simd : {true, false}) {
+      grid.set_simd(simd);
+      std::vector<uint32_t> off, nb;
+      grid.neighbour_lists(ctx, x, cell, off, nb);
+      EXPECT_EQ(from_csr(off, nb), ordered_reference(x, x, x, cell, cell, true))
+          << k << " " << simd;
+      EXPECT_EQ(sorted_lists(from_csr(off, nb)), brute_force_sets(x, x, cell, true));
+    }
+  }
 }
 
 TEST(ParticleGrid, PointsOnCellBoundariesMatchTheBruteForce) {
@@ -199,6 +296,9 @@ TEST(ParticleGrid, ThreadCountDoesNotChangeLargeLists) {
                     0.1 * a * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)));
   const auto [off1, nb1, off2, nb2] = lists_1_and_2_threads(x, R, R);
   ASSERT_GT(nb1.size(), 10 * x.size());
+  ParticleGrid dense;
+  dense.build(x, R);
+  EXPECT_TRUE(dense.dense());
   EXPECT_EQ(off1, off2);
   EXPECT_EQ(nb1, nb2);
   EXPECT_EQ(sorted_lists(from_csr(off1, nb1)), brute_force_sets(x, x, R, true));
