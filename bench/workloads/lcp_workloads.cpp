@@ -8,6 +8,8 @@
 //  - "lcp-wind": one coupled step of dt = 0.2 ms: the SPH air step (as many air sub-steps as its
 //    CFL rule needs, 1 at the default sizes) and one hair step with one leapfrog sub-step, for a
 //    block of hanging strands (100,000 hair particles) in 25,000 air particles.
+// Size "simd" (default 1): 0 runs the scalar hair-hair pair loop instead of the AVX2 batch
+// kernel (same results, ADR 0008), for A/B timing.
 #include <cmath>
 #include <memory>
 
@@ -37,6 +39,7 @@ class LcpStepInstance : public WorkloadInstance {
     // exploded state with particles at up to 100 m/s).
     for (int k = 0; k < 100; ++k) m_scene->step(ctx, 2e-4);
     m_n = double(m_scene->state().x.size());
+    m_scene->use_simd(s.at("simd") != 0);  // after the warm-up: the same state either way
   }
   static hair::LcpParams fixed_params() {
     hair::LcpParams p;
@@ -81,6 +84,7 @@ class LcpWindInstance : public WorkloadInstance {
     p.cfl = 0;
     m_solver =
         std::make_unique<hair::LcpSolver>(p, hair::connect_particles(ctx, x, t, uvs, mass, ip));
+    m_solver->use_simd(s.at("simd") != 0);
     m_state = m_solver->rest_state();
     // Air box around the block, spacing chosen for the requested air particle count.
     hair::SphAirParams ap;
@@ -121,7 +125,7 @@ void add_lcp_workloads(std::vector<Workload>& out) {
   out.push_back({"lcp-step",
                  "LCP hair (Bando 2003): one step = one leapfrog sub-step of 0.1 ms, back hair, "
                  "hair-hair + body on",
-                 {{"particles", 2000}},
+                 {{"particles", 2000}, {"simd", 1}},
                  "particles/s",
                  [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
                    return std::make_unique<LcpStepInstance>(ctx, s);
@@ -129,7 +133,7 @@ void add_lcp_workloads(std::vector<Workload>& out) {
   out.push_back(
       {"lcp-frame",
        "LCP hair (Bando 2003): one 1/60 s frame of the back hair, adaptive leapfrog sub-steps",
-       {{"particles", 2000}},
+       {{"particles", 2000}, {"simd", 1}},
        "particles/s",
        [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
          return std::make_unique<LcpStepInstance>(ctx, s, true);
@@ -137,7 +141,7 @@ void add_lcp_workloads(std::vector<Workload>& out) {
   out.push_back({"lcp-wind",
                  "LCP hair in SPH wind (Bando 2003 §3.6): one coupled step of 0.2 ms (air + 1 hair "
                  "sub-step)",
-                 {{"hair", 100000}, {"air", 25000}},
+                 {{"hair", 100000}, {"air", 25000}, {"simd", 1}},
                  "steps/s",
                  [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
                    return std::make_unique<LcpWindInstance>(ctx, s);

@@ -656,14 +656,20 @@ void pair_index(const Context& ctx, LcpWorkspace& ws) {
   ws.pair_off[0] = 0;
   for (std::size_t i = 0; i < n; ++i) ws.pair_off[i + 1] = ws.pair_off[i] + (off[i + 1] - upper[i]);
   ws.nbr_pair.resize(nb.size());
+  ws.pair_i.resize(ws.pair_off[n]);
+  ws.pair_j.resize(ws.pair_off[n]);
   parallel_for(ctx, 0, n, [&](std::size_t i) {
     // A lower entry's pair is the upper entry nbr_mirror[e] of particle j = nbrs[e].
     for (uint32_t e = off[i]; e < upper[i]; ++e) {
       const uint32_t j = nb[e];
       ws.nbr_pair[e] = ws.pair_off[j] + (ws.nbr_mirror[e] - upper[j]);
     }
-    for (uint32_t e = upper[i]; e < off[i + 1]; ++e)
-      ws.nbr_pair[e] = ws.pair_off[i] + (e - upper[i]);
+    for (uint32_t e = upper[i]; e < off[i + 1]; ++e) {
+      const uint32_t slot = ws.pair_off[i] + (e - upper[i]);
+      ws.nbr_pair[e] = slot;
+      ws.pair_i[slot] = uint32_t(i);
+      ws.pair_j[slot] = nb[e];
+    }
   });
 }
 }  // namespace
@@ -672,8 +678,11 @@ void LcpSolver::pair_scratch(LcpWorkspace& ws) {
   const std::size_t npairs = ws.pair_off.empty() ? 0 : ws.pair_off.back();
   ws.pair_w.resize(npairs);
   ws.pair_f.resize(npairs);
-  ws.pair_act.resize(npairs);
-  ws.act_end.resize(ws.nbr_offsets.empty() ? 0 : ws.nbr_offsets.size() - 1);
+  ws.act_i.resize(npairs);
+  ws.act_j.resize(npairs);
+  ws.act_slot.resize(npairs);
+  const std::size_t n = ws.nbr_offsets.empty() ? 0 : ws.nbr_offsets.size() - 1;
+  ws.act_count.resize((n + kChunk - 1) / kChunk);
 }
 
 void LcpSolver::density_of(std::size_t i, LcpWorkspace& ws, double w0) const {
@@ -717,98 +726,61 @@ void LcpSolver::spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, do
   ws.spring_f[q] = (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
 }
 
-void LcpSolver::active_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
-                                const SphKernel& K) const {
-  // W(h, r) of every pair i < j of the list (0 beyond 2h) and the compact list of the pairs that
-  // interact (0 < r < 2h), stored in i's pair slots from pair_off[i] on; pair_f of the others is
-  // zeroed. Without branches on the distance: with the Verlet skin about a third of the listed
-  // pairs lie beyond 2h, in no predictable order.
-  const double r2max = 4 * m_model.h * m_model.h;
-  const Vec3 xi = s.x[i];
-  const uint32_t e0 = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
-  const uint32_t p0 = ws.pair_off[i], p1 = ws.pair_off[i + 1];
-  // Interacting entries are listed from p0 upwards, the others from p1 downwards; both cursors
-  // write every entry into the free slots [lo, hi) and one of them advances.
-  uint32_t lo = p0, hi = p1;
-  for (uint32_t e = e0; e < e1; ++e) {
-    const double d2 = (s.x[ws.nbrs[e]] - xi).squaredNorm();
-    const double w = K.w(std::sqrt(d2));
-    const bool inside = d2 < r2max;
-    ws.pair_w[p0 + (e - e0)] = inside ? w : 0.0;  // the pair slot of entry e
-    const uint32_t act = (inside && d2 > 0) ? 1u : 0u;
-    ws.pair_act[lo] = e;
-    ws.pair_act[hi - 1] = e;
-    lo += act;
-    hi -= 1u - act;
-  }
-  ws.act_end[i] = lo;
-  for (uint32_t k = lo; k < p1; ++k) ws.pair_f[p0 + (ws.pair_act[k] - e0)] = Vec3::Zero();
+void LcpSolver::active_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
+                                const detail::HairPairConsts& pc) const {
+  // W(h, r) of every pair slot of the particles of chunk c (0 beyond 2h), the compact list of
+  // the pairs that interact (0 < r < 2h) and a zero force in every slot (the interacting ones
+  // are overwritten by hair_pairs_of).
+  const std::size_t n = m_model.size();
+  const std::size_t s0 = ws.pair_off[c * kChunk], s1 = ws.pair_off[std::min(n, (c + 1) * kChunk)];
+  ws.act_count[c] = uint32_t(m_kernels.active(s.x.data(), ws.pair_i.data(), ws.pair_j.data(), pc,
+                                              s0, s1, ws.pair_w.data(), ws.act_i.data(),
+                                              ws.act_j.data(), ws.act_slot.data()));
+  std::fill(ws.pair_f.begin() + std::ptrdiff_t(s0), ws.pair_f.begin() + std::ptrdiff_t(s1),
+            Vec3::Zero());
 }
 
-void LcpSolver::hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
-                              const SphKernel& K, double inv_w0) const {
-  // Hair-hair force (3.16)-(3.18) on i from j, once per interacting pair (i < j, listed by
-  // active_pairs_of); j gets the negation.
-  const auto& m = m_model;
-  const auto& p = m_params;
-  const double eps2 = p.colinear_eps * p.colinear_eps;
-  const Vec3 xi = s.x[i], vi = s.v[i], ti = s.t[i];
-  const double mi = m.mass[i], pi = ws.p_rho2[i];
-  const uint32_t e0 = ws.nbr_upper[i], p0 = ws.pair_off[i];  // pair slot of e: p0 + (e - e0)
-  for (uint32_t k = p0; k < ws.act_end[i]; ++k) {
-    const uint32_t e = ws.pair_act[k];
-    const uint32_t j = ws.nbrs[e];
-    const Vec3 xab = s.x[j] - xi;
-    const double r = std::sqrt(xab.squaredNorm());
-    const Vec3 xh = xab * (1.0 / r);
-    double w, dw;
-    K.w_dw(r, w, dw);
-    const double mj = m.mass[j];
-    // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i,
-    // dW/dx_i = -W' x^_ij
-    Vec3 f = mi * mj * (pi + ws.p_rho2[j]) * dw * xh;
-    // Collision direction d_n = t_i x t_j. Near-colinear hairs: the paper prints
-    // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is
-    // t_i, i.e. ALONG the hair, contradicting "normal to the hair directions". We use the
-    // part of x^_ij normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which the case needs.
-    // Both are computed and one selected: neighbouring hairs are often near-colinear.
-    const Vec3 dc = ti.cross(s.t[j]);
-    const Vec3 dp = xh - xh.dot(ti) * ti;
-    const double dc2 = dc.squaredNorm(), dp2 = dp.squaredNorm();
-    const bool colinear = dc2 < eps2;
-    const double dn2 = colinear ? dp2 : dc2;
-    const Vec3 dn(colinear ? dp.x() : dc.x(), colinear ? dp.y() : dc.y(),
-                  colinear ? dp.z() : dc.z());
-    if (dn2 >= 1e-18) {
-      const Vec3 dh = dn * (1.0 / std::sqrt(dn2));
-      const Vec3 vab = s.v[j] - vi;
-      // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one
-      // setting works for any particle count: d_c(paper) = d_c mu / W(h, 0).
-      const double muw = mi * mj / (mi + mj) * (w * inv_w0);
-      const double vn = vab.dot(dh);
-      // (3.17) only while the pair approaches along d_n
-      const double dc_on = vn * xab.dot(dh) < 0 ? p.collision_damping : 0.0;
-      f += dc_on * muw * vn * dh;
-      f += p.friction_damping * muw * (vab - vn * dh);  // (3.18) d_f W (v_ij . d^_t) d^_t
-    }
-    ws.pair_f[p0 + (e - e0)] = f;
-  }
+detail::HairPairConsts LcpSolver::pair_consts(const SphKernel& K, double inv_w0) const {
+  detail::HairPairConsts c;
+  c.inv_h = K.inv_h;
+  c.sigma_w = K.sigma_w;
+  c.sigma_dw = K.sigma_dw;
+  c.inv_w0 = inv_w0;
+  c.r2max = 4 * m_model.h * m_model.h;
+  c.eps2 = m_params.colinear_eps * m_params.colinear_eps;
+  c.collision_damping = m_params.collision_damping;
+  c.friction_damping = m_params.friction_damping;
+  return c;
 }
 
-Vec3 LcpSolver::gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const {
-  // Gather in a fixed order (connections by role, then the neighbour list): deterministic for
-  // any thread count, and each pair's two contributions are exact negations.
-  Vec3 f = Vec3::Zero();
-  for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e) f += ws.spring_f[m_ts_pairs[e]];
-  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) f -= ws.spring_f[m_rs_pairs[e]];
+void LcpSolver::hair_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
+                              const detail::HairPairConsts& pc) const {
+  // Hair-hair force (3.16)-(3.18) on i from j, once per interacting pair (i < j) of the
+  // particles of chunk c, as listed by active_pairs_of; j gets the negation. One batch for the
+  // chunk: AVX2 runs across pairs of different particles (a particle has only about three).
+  const detail::HairPairInputs in{s.x.data(), s.v.data(), s.t.data(), m_model.mass.data(),
+                                  ws.p_rho2.data()};
+  const std::size_t s0 = ws.pair_off[c * kChunk];
+  m_kernels.forces(in, pc, ws.act_i.data() + s0, ws.act_j.data() + s0, ws.act_slot.data() + s0,
+                   ws.act_count[c], ws.pair_f.data());
+}
+
+detail::GatherInputs LcpSolver::gather_inputs(const LcpWorkspace& ws, bool hh) const {
+  detail::GatherInputs g;
+  g.ts_off = m_ts_offsets.data();
+  g.ts_pairs = m_ts_pairs.data();
+  g.rs_off = m_rs_offsets.data();
+  g.rs_pairs = m_rs_pairs.data();
+  g.spring_f = ws.spring_f.data();
+  g.hh = hh;
   if (hh) {
-    // The lists are sorted: entries below nbr_upper[i] are pairs evaluated by the other end.
-    const uint32_t e0 = ws.nbr_offsets[i], eu = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
-    for (uint32_t e = e0; e < eu; ++e) f -= ws.pair_f[ws.nbr_pair[e]];
-    const uint32_t p0 = ws.pair_off[i];  // pair slot of entry e >= eu: p0 + (e - eu)
-    for (uint32_t e = eu; e < e1; ++e) f += ws.pair_f[p0 + (e - eu)];
+    g.nbr_off = ws.nbr_offsets.data();
+    g.nbr_upper = ws.nbr_upper.data();
+    g.nbr_pair = ws.nbr_pair.data();
+    g.pair_off = ws.pair_off.data();
+    g.pair_f = ws.pair_f.data();
   }
-  return f;
+  return g;
 }
 
 void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
@@ -832,71 +804,67 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
       ws.p_rho2[i] = ws.pressure[i] / (ws.density[i] * ws.density[i]);
     pair_scratch(ws);
     const SphKernel K(m.h);
-    const double inv_w0 = 1.0 / K.w(0.0);
-    parallel_for(ctx, 0, n, [&](std::size_t i) {
-      active_pairs_of(i, s, ws, K);
-      hair_pairs_of(i, s, ws, K, inv_w0);
-    });
+    const detail::HairPairConsts pc = pair_consts(K, 1.0 / K.w(0.0));
+    parallel_for(
+        ctx, 0, ws.act_count.size(),
+        [&](std::size_t c) {
+          active_pairs_of(c, s, ws, pc);
+          hair_pairs_of(c, s, ws, pc);
+        },
+        1);
   }
-  parallel_for(ctx, 0, n, [&](std::size_t i) { ws.force[i] = gather_of(i, ws, hh); });
+  const detail::GatherInputs gin = gather_inputs(ws, hh);
+  parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
+    m_kernels.gather(gin, i0, i1, ws.force.data());
+  });
 }
+
+namespace {
+// |x_ab| and x^_ab of connection q (x_ab = x_b - x_a): shared by k_ij (3.7), the spring forces
+// and the direction update (3.15) of both ends (x_ji = -x_ij exactly).
+inline void connection_geometry(const Vec3& xa, const Vec3& xb, double& r, Vec3& xh) {
+  const Vec3 d = xb - xa;  // x_ab
+  r = d.norm();
+  xh = d * (1.0 / r);
+}
+}  // namespace
 
 void LcpSolver::geometry_of(std::size_t q, const LcpState& s, LcpWorkspace& ws) const {
-  // |x_ab| and x^_ab of connection q. direction_of computes the same expression when it does
-  // not read the cache, so both give the same bits.
-  const Vec3 d = s.x[m_model.pair_b[q]] - s.x[m_model.pair_a[q]];  // x_ab
-  const double r = d.norm();
-  ws.conn_r[q] = r;
-  ws.conn_xh[q] = d * (1.0 / r);
+  connection_geometry(s.x[m_model.pair_a[q]], s.x[m_model.pair_b[q]], ws.conn_r[q], ws.conn_xh[q]);
 }
 
-void LcpSolver::direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws,
-                             bool cached) const {
-  const auto& m = m_model;
-  if (m.root[i]) return;
-  const Vec3 ti = s.t[i];
-  // (3.15) t_i = sum_j alpha_ij k_ij t_i^j / |.|, with t_i^j the unit vector at angle theta0_ij
-  // from x^_ij in the plane of t_i and x_ij (Fig. 3.3 c):
-  //   t_i^j = cos0 x^ + sin0 (t_i - (t_i . x^) x^) / |t_i - (t_i . x^) x^|.
-  // Summed as acc = sum_j [a_j x^_j] + b t_i with scalar a_j = ak (cos0 - sin0 (t_i . x^) / p_j)
-  // and b = sum_j ak sin0 / p_j (p_j = |t_i - (t_i . x^) x^|; the sin0 part drops when p_j
-  // vanishes, x^ parallel to t_i). sign = +1 where i is the root-side end a (x_ij = x_ab),
-  // -1 where it is the tip-side end b.
-  Vec3 acc = Vec3::Zero();
-  double bsum = 0;
-  // The geometry of a connection is either read from ws.conn_r / conn_xh (filled by
-  // geometry_of) or computed here by the same expression, so both ends see it bit for bit
-  // (x_ji = -x_ij exactly).
-  auto add = [&](uint32_t q, double sign, double c0, double s0) {
-    double r;
-    Vec3 xh;  // x^_ij
-    if (cached) {
-      r = ws.conn_r[q];
-      xh = sign * ws.conn_xh[q];
-    } else {
-      const Vec3 d = s.x[m.pair_b[q]] - s.x[m.pair_a[q]];
-      r = d.norm();
-      xh = sign * (d * (1.0 / r));
-    }
-    if (!(r > 0)) return;
-    const double ak = ws.alpha[q] * ws.k[q];
-    const double d = ti.dot(xh);
-    const double pn = (ti - d * xh).norm();
-    const double sp = pn > 1e-12 ? ak * s0 / pn : 0.0;
-    acc += (ak * c0 - sp * d) * xh;
-    bsum += sp;
-  };
-  for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e)
-    add(m_ts_pairs[e], 1.0, m_ts_cos[e], m_ts_sin[e]);
-  for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e)
-    add(m_rs_pairs[e], -1.0, m_rs_cos[e], m_rs_sin[e]);
-  acc += bsum * ti;
-  const double an = acc.norm();
-  if (an > 1e-300 && std::isfinite(an)) s.t[i] = acc / an;
+detail::DirectionInputs LcpSolver::direction_inputs(const double* conn_r, const Vec3* conn_xh,
+                                                    const LcpWorkspace& ws) const {
+  detail::DirectionInputs d;
+  d.ts_off = m_ts_offsets.data();
+  d.ts_pairs = m_ts_pairs.data();
+  d.ts_cos = m_ts_cos.data();
+  d.ts_sin = m_ts_sin.data();
+  d.rs_off = m_rs_offsets.data();
+  d.rs_pairs = m_rs_pairs.data();
+  d.rs_cos = m_rs_cos.data();
+  d.rs_sin = m_rs_sin.data();
+  d.conn_r = conn_r;
+  d.conn_xh = conn_xh;
+  d.alpha = ws.alpha.data();
+  d.k = ws.k.data();
+  d.root = m_model.root.data();
+  return d;
 }
 
 void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWorkspace& ws) const {
-  parallel_for(ctx, 0, m_model.size(), [&](std::size_t i) { direction_of(i, s, ws, false); });
+  // (3.15) from the current positions (the geometry computed here as in step()).
+  const auto& m = m_model;
+  const std::size_t np = m.num_pairs();
+  std::vector<double> r(np);
+  std::vector<Vec3> xh(np);
+  parallel_for(ctx, 0, np, [&](std::size_t q) {
+    connection_geometry(s.x[m.pair_a[q]], s.x[m.pair_b[q]], r[q], xh[q]);
+  });
+  const detail::DirectionInputs din = direction_inputs(r.data(), xh.data(), ws);
+  parallel_chunks(ctx, m.size(), kChunk, [&](std::size_t i0, std::size_t i1) {
+    m_kernels.directions(din, i0, i1, s.t.data());
+  });
 }
 
 LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpState& s,
@@ -979,7 +947,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.chunk_check.resize(nchunks);
   const double h = m.h;
   const SphKernel K(h);
-  const double w0 = K.w(0.0), inv_w0 = 1.0 / w0;
+  const double w0 = K.w(0.0);
+  const detail::HairPairConsts pc = pair_consts(K, 1.0 / w0);
   const double skin = P.neighbour_skin * 2 * h;
   const double Rn = 2 * h + skin;
   const bool hh = P.hair_hair;
@@ -1008,8 +977,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
           if (do_alpha) coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
           if (!hh) continue;
           dmax = std::max(dmax, (s.x[i] - ws.nbr_built_x[i]).squaredNorm());
-          active_pairs_of(i, s, ws, K);
         }
+        if (hh) active_pairs_of(i0 / kChunk, s, ws, pc);
         ws.chunk_max[i0 / kChunk] = dmax;
       });
       if (!hh || rebuild) break;
@@ -1038,68 +1007,69 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     const bool alpha_here = do_alpha && P.alpha_sweeps == 0;
     // 3. alpha (3.14) and springs once per connection (indices 0 .. np - 1), hair-hair forces
     // once per pair (particle i at index np + i): one parallel loop over both.
+    const std::size_t nconn = (np + kChunk - 1) / kChunk;
     parallel_for(
-        ctx, 0, np + (hh ? n : 0),
-        [&](std::size_t k) {
-          if (k < np) {
+        ctx, 0, nconn + (hh ? nchunks : 0),
+        [&](std::size_t c) {
+          if (c >= nconn) return hair_pairs_of(c - nconn, s, ws, pc);
+          for (std::size_t k = c * kChunk; k < std::min(np, (c + 1) * kChunk); ++k) {
             if (alpha_here)  // (3.14): a is root-side (in N_r(b)), b is tip-side (in N_t(a))
               ws.alpha[k] = 0.5 * (ws.alpha_r[m.pair_b[k]] + ws.alpha_t[m.pair_a[k]]);
             spring_of(k, s, ws, ws.conn_r[k], ws.conn_xh[k]);
-          } else {
-            hair_pairs_of(k - np, s, ws, K, inv_w0);
           }
         },
-        kChunk);
+        1);
     // 4. Gather, accelerations and the leapfrog update (each particle reads only its own state
     // besides the per-pair forces): v(t + dt/2) = v(t - dt/2) + a(t) dt, x(t + dt) = x(t) +
     // v(t + dt/2) dt.
-    parallel_for(
-        ctx, 0, n,
-        [&](std::size_t i) {
-          const Vec3 force = gather_of(i, ws, hh);
-          ws.force[i] = force;
-          if (m.root[i]) {
-            ws.accel[i] = Vec3::Zero();
-            ws.contact[i] = 0;
-            ws.penetration[i] = 0;
-            s.x[i] = m.rest_x[i];
-            s.v[i] = Vec3::Zero();
-            return;
+    const detail::GatherInputs gin = gather_inputs(ws, hh);
+    parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
+      m_kernels.gather(gin, i0, i1, ws.force.data());
+      for (std::size_t i = i0; i < i1; ++i) {
+        const Vec3 force = ws.force[i];
+        if (m.root[i]) {
+          ws.accel[i] = Vec3::Zero();
+          ws.contact[i] = 0;
+          ws.penetration[i] = 0;
+          s.x[i] = m.rest_x[i];
+          s.v[i] = Vec3::Zero();
+          continue;
+        }
+        const double mi = m.mass[i];
+        const Vec3 r = s.x[i] - piv;  // head-frame lever arm about the pivot
+        Vec3 a = force / mi + g_h;
+        // Inertial forces due to head movement (§3.6).
+        a -= A_h + al_h.cross(r) + w_h.cross(w_h.cross(r)) + 2.0 * w_h.cross(s.v[i]);
+        // Air friction against still air: world velocity = V + omega x r + v.
+        a -= P.air_drag * (V_h + w_h.cross(r) + s.v[i]);
+        if (in.external_force) a += Rt * (*in.external_force)[i] / mi;
+        uint8_t c = 0;
+        double pdepth = 0;
+        if (P.body_collision && m_body) {
+          if (const sim::BodyPlane* pl = m_body->find(s.x[i])) {
+            const Vec3 ac = sim::body_contact_accel(*pl, s.x[i], s.v[i], a, dt, P.contact);
+            if (ac.squaredNorm() > 0) c = 1;
+            a += ac;
+            pdepth = std::max(0.0, -(s.x[i] - pl->p).dot(pl->n));
           }
-          const double mi = m.mass[i];
-          const Vec3 r = s.x[i] - piv;  // head-frame lever arm about the pivot
-          Vec3 a = force / mi + g_h;
-          // Inertial forces due to head movement (§3.6).
-          a -= A_h + al_h.cross(r) + w_h.cross(w_h.cross(r)) + 2.0 * w_h.cross(s.v[i]);
-          // Air friction against still air: world velocity = V + omega x r + v.
-          a -= P.air_drag * (V_h + w_h.cross(r) + s.v[i]);
-          if (in.external_force) a += Rt * (*in.external_force)[i] / mi;
-          uint8_t c = 0;
-          double pdepth = 0;
-          if (P.body_collision && m_body) {
-            if (const sim::BodyPlane* pl = m_body->find(s.x[i])) {
-              const Vec3 ac = sim::body_contact_accel(*pl, s.x[i], s.v[i], a, dt, P.contact);
-              if (ac.squaredNorm() > 0) c = 1;
-              a += ac;
-              pdepth = std::max(0.0, -(s.x[i] - pl->p).dot(pl->n));
-            }
-          }
-          ws.contact[i] = c;
-          ws.penetration[i] = pdepth;
-          ws.accel[i] = a;
-          s.v[i] += a * dt;
-          s.x[i] += s.v[i] * dt;
-        },
-        kChunk);
+        }
+        ws.contact[i] = c;
+        ws.penetration[i] = pdepth;
+        ws.accel[i] = a;
+        s.v[i] += a * dt;
+        s.x[i] += s.v[i] * dt;
+      }
+    });
     // 5. Connection geometry at the new positions, then directions (3.15) and the blow-up
     // check: first non-finite or too fast particle, in index order.
     parallel_for(
         ctx, 0, np, [&](std::size_t q) { geometry_of(q, s, ws); }, kChunk);
     const double vlim = P.max_speed;
+    const detail::DirectionInputs din = direction_inputs(ws.conn_r.data(), ws.conn_xh.data(), ws);
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
+      m_kernels.directions(din, i0, i1, s.t.data());  // (3.15)
       LcpWorkspace::ChunkCheck c;
       for (std::size_t i = i0; i < i1; ++i) {
-        direction_of(i, s, ws, true);
         const double sp = s.v[i].norm();
         const bool bad =
             !std::isfinite(sp) || !s.x[i].allFinite() || !s.t[i].allFinite() || sp > vlim;

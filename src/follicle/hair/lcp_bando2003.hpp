@@ -15,6 +15,7 @@
 #include "follicle/core/context.hpp"
 #include "follicle/core/params.hpp"
 #include "follicle/core/types.hpp"
+#include "follicle/hair/lcp_kernels_bando2003.hpp"
 #include "follicle/hair/particle_grid.hpp"
 #include "follicle/hair/scalp_bando2003.hpp"
 #include "follicle/hair/sph_kernel.hpp"
@@ -181,11 +182,12 @@ struct LcpWorkspace {
   // particle i's pairs are the slots pair_off[i] .. pair_off[i + 1] - 1, and nbr_pair[e] is the
   // slot of the pair of entry e (of either end), so the per-pair arrays hold each pair once.
   std::vector<uint32_t> pair_off, nbr_pair;
-  std::vector<double> pair_w;  // W(h, r) per pair slot
-  std::vector<Vec3> pair_f;    // hair-hair force on the lower-index end per pair slot [N]
-  // The list entries of particle i's pairs with 0 < r < 2h, compacted into the slots
-  // [pair_off[i], act_end[i]); the other entries of its pairs follow, up to pair_off[i + 1].
-  std::vector<uint32_t> pair_act, act_end;
+  std::vector<double> pair_w;            // W(h, r) per pair slot
+  std::vector<Vec3> pair_f;              // hair-hair force on the lower-index end per pair slot [N]
+  std::vector<uint32_t> pair_i, pair_j;  // the ends i < j of each pair slot
+  // The interacting pairs (0 < r < 2h) of each chunk c of 64 particles, from index
+  // pair_off[64 c] on (act_count[c] of them): ends and pair slot.
+  std::vector<uint32_t> act_i, act_j, act_slot, act_count;
   std::vector<Vec3> spring_f;       // spring force on the root-side end per connection [N]
   std::vector<double> p_rho2;       // P_i / rho_i^2 per particle
   std::vector<uint8_t> contact;     // per particle, last sub-step
@@ -262,6 +264,11 @@ class LcpSolver {
   /// A_i of (3.9).
   double cross_section(std::size_t i) const;
 
+  /// Selects the hair-hair pair kernels: the AVX2 batch kernels when the CPU has them (default)
+  /// or the scalar loops. Both give the same bits (ADR 0008); the switch is for tests and A/B
+  /// benchmarks.
+  void use_simd(bool on) { m_kernels = detail::lcp_kernels(on); }
+
   const LcpModel& model() const { return m_model; }
   const LcpParams& params() const { return m_params; }
   double rho0() const { return m_rho0; }
@@ -277,14 +284,16 @@ class LcpSolver {
   void alpha_sweeps(const Context& ctx, LcpWorkspace& ws) const;
   void spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, double r,
                  const Vec3& xh) const;
-  void active_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws,
-                       const SphKernel& K) const;
+  void active_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
+                       const detail::HairPairConsts& pc) const;
   static void pair_scratch(LcpWorkspace& ws);
-  void hair_pairs_of(std::size_t i, const LcpState& s, LcpWorkspace& ws, const SphKernel& K,
-                     double inv_w0) const;
-  Vec3 gather_of(std::size_t i, const LcpWorkspace& ws, bool hh) const;
+  detail::HairPairConsts pair_consts(const SphKernel& K, double inv_w0) const;
+  void hair_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
+                     const detail::HairPairConsts& pc) const;
+  detail::GatherInputs gather_inputs(const LcpWorkspace& ws, bool hh) const;
   void geometry_of(std::size_t q, const LcpState& s, LcpWorkspace& ws) const;
-  void direction_of(std::size_t i, LcpState& s, const LcpWorkspace& ws, bool cached) const;
+  detail::DirectionInputs direction_inputs(const double* conn_r, const Vec3* conn_xh,
+                                           const LcpWorkspace& ws) const;
   void density_of(std::size_t i, LcpWorkspace& ws, double w0) const;
   // Each particle's connections split by its role, in adjacency order, so the per-particle loops
   // run without a data-dependent branch per connection: m_rs_* lists the connections of which
@@ -299,6 +308,7 @@ class LcpSolver {
   const sim::VoxelPlanes* m_body = nullptr;
   double m_rho0 = 0;
   SphKernel m_ks{1.0};  // Monaghan's kernel with the connection smoothing length h_s
+  detail::LcpKernels m_kernels = detail::lcp_kernels(true);
 };
 
 /// World positions (and optionally velocities, directions) of the particles for a head sample.

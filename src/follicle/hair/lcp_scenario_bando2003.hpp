@@ -129,6 +129,8 @@ class LcpScenario {
 
   double time() const { return m_state.time; }
   const LcpSolver& solver() const { return *m_solver; }
+  /// LcpSolver::use_simd (same results either way; for A/B benchmarks).
+  void use_simd(bool on) { m_solver->use_simd(on); }
   const LcpState& state() const { return m_state; }  // head frame
   const geom::TriMesh& head() const { return m_head; }
   bool mesh_head() const { return m_mesh_head; }

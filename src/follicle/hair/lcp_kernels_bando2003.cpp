@@ -1,0 +1,412 @@
+#include "follicle/hair/lcp_kernels_bando2003.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define FOLLICLE_LCP_KERNELS_HAVE_AVX2 1
+#endif
+
+namespace follicle::hair::detail {
+
+Vec3 hair_pair_force(const HairPairInputs& in, const HairPairConsts& c, uint32_t i, uint32_t j) {
+  // Every expression below is mirrored operation for operation by the AVX2 kernel: change
+  // both together (the test LcpKernels.BatchKernelGivesTheScalarBits checks the bits).
+  const Vec3 xi = in.x[i], vi = in.v[i], ti = in.t[i];
+  const double mi = in.mass[i], pi = in.p_rho2[i];
+  const Vec3 xab = in.x[j] - xi;
+  const double r = std::sqrt(xab.squaredNorm());
+  const Vec3 xh = xab * (1.0 / r);
+  // Monaghan's kernel as in SphKernel::w_dw.
+  const double q = r * c.inv_h;
+  const double a = std::max(2.0 - q, 0.0), b = std::max(1.0 - q, 0.0);
+  const double w = c.sigma_w * 0.25 * (a * a * a - 4.0 * b * b * b);
+  const double dw = c.sigma_dw * 0.75 * (4.0 * b * b - a * a);
+  const double mj = in.mass[j];
+  // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i,
+  // dW/dx_i = -W' x^_ij
+  Vec3 f = mi * mj * (pi + in.p_rho2[j]) * dw * xh;
+  // Collision direction d_n = t_i x t_j. Near-colinear hairs: the paper prints
+  // d_n = t_i - (t_i . x^_ij) x^_ij, which for side-by-side hairs (x_ij normal to t) is
+  // t_i, i.e. ALONG the hair, contradicting "normal to the hair directions". We use the
+  // part of x^_ij normal to t_i, d_n = x^_ij - (x^_ij . t_i) t_i, which the case needs.
+  // Both are computed and one selected: neighbouring hairs are often near-colinear.
+  const Vec3 dc = ti.cross(in.t[j]);
+  const Vec3 dp = xh - xh.dot(ti) * ti;
+  const double dc2 = dc.squaredNorm(), dp2 = dp.squaredNorm();
+  const bool colinear = dc2 < c.eps2;
+  const double dn2 = colinear ? dp2 : dc2;
+  const Vec3 dn(colinear ? dp.x() : dc.x(), colinear ? dp.y() : dc.y(), colinear ? dp.z() : dc.z());
+  if (dn2 >= 1e-18) {
+    const Vec3 dh = dn * (1.0 / std::sqrt(dn2));
+    const Vec3 vab = in.v[j] - vi;
+    // d_c and d_f are given per reduced mass and per normalised kernel W/W(h,0) so one
+    // setting works for any particle count: d_c(paper) = d_c mu / W(h, 0).
+    const double muw = mi * mj / (mi + mj) * (w * c.inv_w0);
+    const double vn = vab.dot(dh);
+    // (3.17) only while the pair approaches along d_n
+    const double dc_on = vn * xab.dot(dh) < 0 ? c.collision_damping : 0.0;
+    f += dc_on * muw * vn * dh;
+    f += c.friction_damping * muw * (vab - vn * dh);  // (3.18) d_f W (v_ij . d^_t) d^_t
+  }
+  return f;
+}
+
+namespace {
+
+// Slots s0 .. s1 - 1, the interacting ones written from index out on; returns the index after
+// the last one written.
+std::size_t active_from(const Vec3* x, const uint32_t* pair_i, const uint32_t* pair_j,
+                        const HairPairConsts& c, std::size_t s0, std::size_t s1, double* w,
+                        uint32_t* act_i, uint32_t* act_j, uint32_t* act_slot, std::size_t out) {
+  // Without branches on the distance: with the Verlet skin about a third of the listed pairs
+  // lie beyond 2h, in no predictable order.
+  std::size_t cnt = out;
+  for (std::size_t s = s0; s < s1; ++s) {
+    const uint32_t i = pair_i[s], j = pair_j[s];
+    const double d2 = (x[j] - x[i]).squaredNorm();
+    // Monaghan's kernel as in SphKernel::w.
+    const double q = std::sqrt(d2) * c.inv_h;
+    const double a = std::max(2.0 - q, 0.0), b = std::max(1.0 - q, 0.0);
+    const double wk = c.sigma_w * 0.25 * (a * a * a - 4.0 * b * b * b);
+    const bool inside = d2 < c.r2max;
+    w[s] = inside ? wk : 0.0;
+    act_i[cnt] = i;
+    act_j[cnt] = j;
+    act_slot[cnt] = uint32_t(s);
+    cnt += (inside && d2 > 0) ? 1 : 0;
+  }
+  return cnt;
+}
+
+std::size_t active_scalar(const Vec3* x, const uint32_t* pair_i, const uint32_t* pair_j,
+                          const HairPairConsts& c, std::size_t s0, std::size_t s1, double* w,
+                          uint32_t* act_i, uint32_t* act_j, uint32_t* act_slot) {
+  return active_from(x, pair_i, pair_j, c, s0, s1, w, act_i, act_j, act_slot, s0) - s0;
+}
+
+void batch_scalar(const HairPairInputs& in, const HairPairConsts& c, const uint32_t* i,
+                  const uint32_t* j, const uint32_t* slot, std::size_t count, Vec3* out) {
+  for (std::size_t k = 0; k < count; ++k) out[slot[k]] = hair_pair_force(in, c, i[k], j[k]);
+}
+
+void directions_scalar(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t) {
+  for (std::size_t i = i0; i < i1; ++i) {
+    if (in.root[i]) continue;
+    const Vec3 ti = t[i];
+    // (3.15) t_i = sum_j alpha_ij k_ij t_i^j / |.|, with t_i^j the unit vector at angle theta0_ij
+    // from x^_ij in the plane of t_i and x_ij (Fig. 3.3 c):
+    //   t_i^j = cos0 x^ + sin0 (t_i - (t_i . x^) x^) / |t_i - (t_i . x^) x^|.
+    // Summed as acc = sum_j [a_j x^_j] + b t_i with scalar a_j = ak (cos0 - sin0 (t_i . x^) / p_j)
+    // and b = sum_j ak sin0 / p_j (p_j = |t_i - (t_i . x^) x^|; the sin0 part drops when p_j
+    // vanishes, x^ parallel to t_i). sign = +1 where i is the root-side end a (x_ij = x_ab),
+    // -1 where it is the tip-side end b. Mirrored operation for operation by avx2::directions.
+    Vec3 acc = Vec3::Zero();
+    double bsum = 0;
+    auto add = [&](uint32_t q, double sign, double c0, double s0) {
+      const double r = in.conn_r[q];
+      const Vec3 xh = sign * in.conn_xh[q];  // x^_ij
+      if (!(r > 0)) return;
+      const double ak = in.alpha[q] * in.k[q];
+      const double d = ti.dot(xh);
+      const double pn = (ti - d * xh).norm();
+      const double sp = pn > 1e-12 ? ak * s0 / pn : 0.0;
+      acc += (ak * c0 - sp * d) * xh;
+      bsum += sp;
+    };
+    for (uint32_t e = in.ts_off[i]; e < in.ts_off[i + 1]; ++e)
+      add(in.ts_pairs[e], 1.0, in.ts_cos[e], in.ts_sin[e]);
+    for (uint32_t e = in.rs_off[i]; e < in.rs_off[i + 1]; ++e)
+      add(in.rs_pairs[e], -1.0, in.rs_cos[e], in.rs_sin[e]);
+    acc += bsum * ti;
+    const double an = acc.norm();
+    if (an > 1e-300 && std::isfinite(an)) t[i] = acc / an;
+  }
+}
+
+void gather_scalar(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force) {
+  // A fixed order: deterministic for any thread count, and each pair's two contributions are
+  // exact negations. Mirrored by avx2::gather.
+  for (std::size_t i = i0; i < i1; ++i) {
+    Vec3 f = Vec3::Zero();
+    for (uint32_t e = in.ts_off[i]; e < in.ts_off[i + 1]; ++e) f += in.spring_f[in.ts_pairs[e]];
+    for (uint32_t e = in.rs_off[i]; e < in.rs_off[i + 1]; ++e) f -= in.spring_f[in.rs_pairs[e]];
+    if (in.hh) {
+      // The lists are sorted: entries below nbr_upper[i] are pairs evaluated by the other end.
+      const uint32_t e0 = in.nbr_off[i], eu = in.nbr_upper[i], e1 = in.nbr_off[i + 1];
+      for (uint32_t e = e0; e < eu; ++e) f -= in.pair_f[in.nbr_pair[e]];
+      const uint32_t p0 = in.pair_off[i];  // pair slot of entry e >= eu: p0 + (e - eu)
+      for (uint32_t e = eu; e < e1; ++e) f += in.pair_f[p0 + (e - eu)];
+    }
+    force[i] = f;
+  }
+}
+
+}  // namespace
+
+#ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
+#pragma GCC push_options
+// AVX2 without FMA: no contraction, so each lane rounds exactly as the scalar code.
+#pragma GCC target("avx2")
+namespace avx2 {
+
+// Hand-written SIMD (no library in the stack gathers from an array of Vec3): GCC vector
+// extensions for the arithmetic, AVX2 gathers for the per-particle inputs.
+typedef double V __attribute__((vector_size(32)));
+
+inline V splat(double s) {
+  return V{s, s, s, s};
+}
+// The masked form with every lane on: the plain _mm256_i32gather_pd starts from an undefined
+// register, which GCC 12 reports as maybe-uninitialized.
+inline V gather1(const double* base, __m128i idx) {
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  return V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), base, idx, all, 8));
+}
+// Component `comp` of the Vec3 at indices idx3 / 3 (idx3 holds 3 * index).
+inline V gather(const double* base, __m128i idx3, int comp) {
+  return gather1(base + comp, idx3);
+}
+inline V vsqrt(V a) {
+  return V(_mm256_sqrt_pd(__m256d(a)));
+}
+
+void batch(const HairPairInputs& in, const HairPairConsts& c, const uint32_t* I, const uint32_t* J,
+           const uint32_t* S, std::size_t count, Vec3* out) {
+  const double* X = in.x->data();
+  const double* Vv = in.v->data();
+  const double* T = in.t->data();
+  const V zero = splat(0.0), one = splat(1.0), two = splat(2.0), four = splat(4.0);
+  const V inv_h = splat(c.inv_h), sw = splat(c.sigma_w * 0.25), sdw = splat(c.sigma_dw * 0.75);
+  const V inv_w0 = splat(c.inv_w0), eps2 = splat(c.eps2), tiny = splat(1e-18);
+  const V cd = splat(c.collision_damping), fd = splat(c.friction_damping);
+  std::size_t k = 0;
+  for (; k + 4 <= count; k += 4) {
+    const __m128i ii = _mm_loadu_si128(reinterpret_cast<const __m128i*>(I + k));
+    const __m128i jj = _mm_loadu_si128(reinterpret_cast<const __m128i*>(J + k));
+    const __m128i i3 = _mm_add_epi32(_mm_add_epi32(ii, ii), ii);
+    const __m128i j3 = _mm_add_epi32(_mm_add_epi32(jj, jj), jj);
+    const V xix = gather(X, i3, 0), xiy = gather(X, i3, 1), xiz = gather(X, i3, 2);
+    const V tix = gather(T, i3, 0), tiy = gather(T, i3, 1), tiz = gather(T, i3, 2);
+    const V mi = gather1(in.mass, ii), pi = gather1(in.p_rho2, ii);
+    const V mj = gather1(in.mass, jj), pj = gather1(in.p_rho2, jj);
+    const V ax = gather(X, j3, 0) - xix, ay = gather(X, j3, 1) - xiy,
+            az = gather(X, j3, 2) - xiz;  // x_ab
+    const V r = vsqrt(ax * ax + ay * ay + az * az);
+    const V inv_r = one / r;
+    const V hx = ax * inv_r, hy = ay * inv_r, hz = az * inv_r;  // x^_ij
+    const V q = r * inv_h;
+    V a = two - q, b = one - q;
+    a = a < zero ? zero : a;  // std::max(., 0.0)
+    b = b < zero ? zero : b;
+    const V w = sw * (a * a * a - four * b * b * b);
+    const V dw = sdw * (four * b * b - a * a);
+    const V s16 = mi * mj * (pi + pj) * dw;  // (3.16)
+    V fx = s16 * hx, fy = s16 * hy, fz = s16 * hz;
+    const V tjx = gather(T, j3, 0), tjy = gather(T, j3, 1), tjz = gather(T, j3, 2);
+    const V dcx = tiy * tjz - tiz * tjy, dcy = tiz * tjx - tix * tjz, dcz = tix * tjy - tiy * tjx;
+    const V d = hx * tix + hy * tiy + hz * tiz;
+    const V dpx = hx - d * tix, dpy = hy - d * tiy, dpz = hz - d * tiz;
+    const V dc2 = dcx * dcx + dcy * dcy + dcz * dcz, dp2 = dpx * dpx + dpy * dpy + dpz * dpz;
+    const auto colinear = dc2 < eps2;
+    const V dn2 = colinear ? dp2 : dc2;
+    const V nx = colinear ? dpx : dcx, ny = colinear ? dpy : dcy, nz = colinear ? dpz : dcz;
+    const V inv_n = one / vsqrt(dn2);
+    const V ex = nx * inv_n, ey = ny * inv_n, ez = nz * inv_n;  // d^_n
+    const V vax = gather(Vv, j3, 0) - gather(Vv, i3, 0),
+            vay = gather(Vv, j3, 1) - gather(Vv, i3, 1),
+            vaz = gather(Vv, j3, 2) - gather(Vv, i3, 2);  // v_ij
+    const V muw = mi * mj / (mi + mj) * (w * inv_w0);
+    const V vn = vax * ex + vay * ey + vaz * ez;
+    const V xn = ax * ex + ay * ey + az * ez;
+    const V dc_on = vn * xn < zero ? cd : zero;  // (3.17) while approaching
+    const V s17 = dc_on * muw * vn;
+    const V s18 = fd * muw;  // (3.18)
+    const V gx = (fx + s17 * ex) + s18 * (vax - vn * ex);
+    const V gy = (fy + s17 * ey) + s18 * (vay - vn * ey);
+    const V gz = (fz + s17 * ez) + s18 * (vaz - vn * ez);
+    const auto on = dn2 >= tiny;
+    fx = on ? gx : fx;
+    fy = on ? gy : fy;
+    fz = on ? gz : fz;
+    for (int l = 0; l < 4; ++l) out[S[k + l]] = Vec3(fx[l], fy[l], fz[l]);
+  }
+  batch_scalar(in, c, I + k, J + k, S + k, count - k, out);
+}
+
+std::size_t active(const Vec3* x, const uint32_t* pair_i, const uint32_t* pair_j,
+                   const HairPairConsts& c, std::size_t s0, std::size_t s1, double* w,
+                   uint32_t* act_i, uint32_t* act_j, uint32_t* act_slot) {
+  const double* X = x->data();
+  const V zero = splat(0.0), one = splat(1.0), two = splat(2.0), four = splat(4.0);
+  const V inv_h = splat(c.inv_h), sw = splat(c.sigma_w * 0.25), r2max = splat(c.r2max);
+  std::size_t cnt = s0, s = s0;
+  for (; s + 4 <= s1; s += 4) {
+    const __m128i ii = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pair_i + s));
+    const __m128i jj = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pair_j + s));
+    const __m128i i3 = _mm_add_epi32(_mm_add_epi32(ii, ii), ii);
+    const __m128i j3 = _mm_add_epi32(_mm_add_epi32(jj, jj), jj);
+    const V dx = gather(X, j3, 0) - gather(X, i3, 0), dy = gather(X, j3, 1) - gather(X, i3, 1),
+            dz = gather(X, j3, 2) - gather(X, i3, 2);
+    const V d2 = dx * dx + dy * dy + dz * dz;
+    const V q = vsqrt(d2) * inv_h;
+    V a = two - q, b = one - q;
+    a = a < zero ? zero : a;
+    b = b < zero ? zero : b;
+    const V wk = sw * (a * a * a - four * b * b * b);
+    const auto inside = d2 < r2max;
+    const V wv = inside ? wk : zero;
+    std::memcpy(w + s, &wv, sizeof(wv));
+    const int act = _mm256_movemask_pd(__m256d(V(inside & (d2 > zero))));
+    for (int l = 0; l < 4; ++l) {  // compaction without branches
+      act_i[cnt] = pair_i[s + l];
+      act_j[cnt] = pair_j[s + l];
+      act_slot[cnt] = uint32_t(s + l);
+      cnt += (act >> l) & 1;
+    }
+  }
+  return active_from(x, pair_i, pair_j, c, s, s1, w, act_i, act_j, act_slot, cnt) - s0;
+}
+
+void directions(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t) {
+  // Four particles at a time, one per lane; each lane adds its own connection ends in the
+  // scalar order (ts list, then rs list), lanes without an end at step k keep their sums.
+  const double* T = t->data();
+  const double* XH = in.conn_xh->data();
+  const V zero = splat(0.0), tiny = splat(1e-12), huge = splat(1e-300);
+  const V inf = splat(std::numeric_limits<double>::infinity());
+  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+  std::size_t i = i0;
+  for (; i + 4 <= i1; i += 4) {
+    uint32_t roots;
+    std::memcpy(&roots, in.root + i, 4);
+    if (roots == 0x01010101u) continue;
+    const __m128i ii = _mm_add_epi32(_mm_set1_epi32(int(i)), lane);
+    const __m128i i3 = _mm_add_epi32(_mm_add_epi32(ii, ii), ii);
+    const V tx = gather(T, i3, 0), ty = gather(T, i3, 1), tz = gather(T, i3, 2);
+    V ax = zero, ay = zero, az = zero, bsum = zero;
+    for (int role = 0; role < 2; ++role) {
+      const uint32_t* off = role == 0 ? in.ts_off : in.rs_off;
+      const uint32_t* pairs = role == 0 ? in.ts_pairs : in.rs_pairs;
+      const double* cs = role == 0 ? in.ts_cos : in.rs_cos;
+      const double* sn = role == 0 ? in.ts_sin : in.rs_sin;
+      const V sign = splat(role == 0 ? 1.0 : -1.0);
+      const __m128i e0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(off + i));
+      const __m128i len =
+          _mm_sub_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(off + i + 1)), e0);
+      alignas(16) uint32_t lens[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(lens), len);
+      const uint32_t kmax = std::max(std::max(lens[0], lens[1]), std::max(lens[2], lens[3]));
+      for (uint32_t k = 0; k < kmax; ++k) {
+        const __m128i kk = _mm_set1_epi32(int(k));
+        const __m128i on32 = _mm_cmpgt_epi32(len, kk);  // k < len (lengths < 2^31)
+        const __m256d on64 = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(on32));
+        const __m128i e = _mm_add_epi32(e0, kk);
+        const __m128i q = _mm_mask_i32gather_epi32(_mm_setzero_si128(),
+                                                   reinterpret_cast<const int*>(pairs), e, on32, 4);
+        const __m128i q3 = _mm_add_epi32(_mm_add_epi32(q, q), q);
+        const V c0 = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), cs, e, on64, 8));
+        const V s0 = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), sn, e, on64, 8));
+        const V r = gather1(in.conn_r, q);
+        const V xx = sign * gather(XH, q3, 0), xy = sign * gather(XH, q3, 1),
+                xz = sign * gather(XH, q3, 2);
+        const V ak = gather1(in.alpha, q) * gather1(in.k, q);
+        const V d = tx * xx + ty * xy + tz * xz;
+        const V px = tx - d * xx, py = ty - d * xy, pz = tz - d * xz;
+        const V pn = vsqrt(px * px + py * py + pz * pz);
+        const V sp = pn > tiny ? ak * s0 / pn : zero;
+        const V coef = ak * c0 - sp * d;
+        const auto valid = (V(on64) != zero) & (r > zero);
+        ax = valid ? ax + coef * xx : ax;
+        ay = valid ? ay + coef * xy : ay;
+        az = valid ? az + coef * xz : az;
+        bsum = valid ? bsum + sp : bsum;
+      }
+    }
+    ax = ax + bsum * tx;
+    ay = ay + bsum * ty;
+    az = az + bsum * tz;
+    const V an = vsqrt(ax * ax + ay * ay + az * az);
+    const auto ok = (an > huge) & (an < inf);
+    const V nx = ax / an, ny = ay / an, nz = az / an;
+    for (int l = 0; l < 4; ++l)
+      if (!in.root[i + std::size_t(l)] && ok[l]) t[i + std::size_t(l)] = Vec3(nx[l], ny[l], nz[l]);
+  }
+  directions_scalar(in, i, i1, t);
+}
+
+// Adds (or subtracts) src[index[start + k]] (src[start + k] without index) for k < len, lane by
+// lane in k order; a lane past its length keeps its sum.
+inline void accumulate(const double* src, const uint32_t* index, __m128i start, __m128i len,
+                       bool subtract, V& fx, V& fy, V& fz) {
+  alignas(16) uint32_t lens[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(lens), len);
+  const uint32_t kmax = std::max(std::max(lens[0], lens[1]), std::max(lens[2], lens[3]));
+  for (uint32_t k = 0; k < kmax; ++k) {
+    const __m128i kk = _mm_set1_epi32(int(k));
+    const __m128i on32 = _mm_cmpgt_epi32(len, kk);
+    const __m256d on64 = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(on32));
+    __m128i q = _mm_add_epi32(start, kk);
+    if (index)
+      q = _mm_mask_i32gather_epi32(_mm_setzero_si128(), reinterpret_cast<const int*>(index), q,
+                                   on32, 4);
+    const __m128i q3 = _mm_add_epi32(_mm_add_epi32(q, q), q);
+    const V x = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), src, q3, on64, 8));
+    const V y = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), src + 1, q3, on64, 8));
+    const V z = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), src + 2, q3, on64, 8));
+    const auto on = V(on64) != splat(0.0);
+    if (subtract) {
+      fx = on ? fx - x : fx;
+      fy = on ? fy - y : fy;
+      fz = on ? fz - z : fz;
+    } else {
+      fx = on ? fx + x : fx;
+      fy = on ? fy + y : fy;
+      fz = on ? fz + z : fz;
+    }
+  }
+}
+
+inline __m128i load4(const uint32_t* p) {
+  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+}
+
+void gather(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force) {
+  // Four particles at a time, one per lane, each summing in the scalar order.
+  const double* SF = in.spring_f->data();
+  const double* PF = in.hh ? in.pair_f->data() : nullptr;
+  std::size_t i = i0;
+  for (; i + 4 <= i1; i += 4) {
+    V fx = splat(0.0), fy = splat(0.0), fz = splat(0.0);
+    __m128i a = load4(in.ts_off + i);
+    accumulate(SF, in.ts_pairs, a, _mm_sub_epi32(load4(in.ts_off + i + 1), a), false, fx, fy, fz);
+    a = load4(in.rs_off + i);
+    accumulate(SF, in.rs_pairs, a, _mm_sub_epi32(load4(in.rs_off + i + 1), a), true, fx, fy, fz);
+    if (in.hh) {
+      const __m128i e0 = load4(in.nbr_off + i), eu = load4(in.nbr_upper + i);
+      accumulate(PF, in.nbr_pair, e0, _mm_sub_epi32(eu, e0), true, fx, fy, fz);
+      accumulate(PF, nullptr, load4(in.pair_off + i), _mm_sub_epi32(load4(in.nbr_off + i + 1), eu),
+                 false, fx, fy, fz);
+    }
+    for (int l = 0; l < 4; ++l) force[i + std::size_t(l)] = Vec3(fx[l], fy[l], fz[l]);
+  }
+  gather_scalar(in, i, i1, force);
+}
+
+}  // namespace avx2
+#pragma GCC pop_options
+#endif
+
+LcpKernels lcp_kernels(bool allow_simd) {
+#ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
+  if (allow_simd && __builtin_cpu_supports("avx2"))
+    return {&avx2::active, &avx2::batch, &avx2::directions, &avx2::gather, true};
+#endif
+  (void)allow_simd;
+  return {&active_scalar, &batch_scalar, &directions_scalar, &gather_scalar, false};
+}
+
+}  // namespace follicle::hair::detail

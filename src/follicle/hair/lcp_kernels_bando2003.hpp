@@ -1,0 +1,99 @@
+#pragma once
+// Inner kernels of the loosely connected particles' sub-step (Bando 2003): for the hair-hair
+// pairs (§3.3.3) the kernel W(h, r) of every listed pair with the selection of the interacting
+// ones (0 < r < 2h) and the pair force (3.16)-(3.18); the hair direction update (3.15). Each has
+// a scalar reference and a batch version that uses AVX2 (4 pairs or 4 particles per
+// instruction, double precision) when the CPU has it. The AVX2 versions perform the same IEEE
+// operations in the same order as the scalar code, lane by lane (no FMA, no reduction across
+// lanes), so both give the same bits; the solver's results do not depend on which runs
+// (ADR 0008).
+#include <cstddef>
+#include <cstdint>
+
+#include "follicle/core/types.hpp"
+
+namespace follicle::hair::detail {
+
+/// Per-particle inputs of the pair force (arrays indexed by particle).
+struct HairPairInputs {
+  const Vec3* x = nullptr;         // positions [m]
+  const Vec3* v = nullptr;         // velocities [m/s]
+  const Vec3* t = nullptr;         // unit hair directions
+  const double* mass = nullptr;    // [kg]
+  const double* p_rho2 = nullptr;  // P_i / rho_i^2
+};
+
+/// Constants of the pair force.
+struct HairPairConsts {
+  double inv_h = 0, sigma_w = 0, sigma_dw = 0;  // Monaghan's kernel (SphKernel) for h
+  double inv_w0 = 0;                            // 1 / W(h, 0)
+  double r2max = 0;                             // (2h)^2
+  double eps2 = 0;                              // colinear_eps^2
+  double collision_damping = 0;                 // d_c of (3.17) per reduced mass [1/s]
+  double friction_damping = 0;                  // d_f of (3.18) per reduced mass [1/s]
+};
+
+/// Force on particle i from particle j (0 < |x_j - x_i| < 2h), the reference for the batch
+/// kernel: (3.16) pressure, (3.17) inelastic collision along the collision direction, (3.18)
+/// friction.
+Vec3 hair_pair_force(const HairPairInputs& in, const HairPairConsts& c, uint32_t i, uint32_t j);
+
+/// Evaluates hair_pair_force for pairs (i[k], j[k]), k < count, into out[slot[k]].
+using HairPairBatchFn = void (*)(const HairPairInputs& in, const HairPairConsts& c,
+                                 const uint32_t* i, const uint32_t* j, const uint32_t* slot,
+                                 std::size_t count, Vec3* out);
+
+/// For the pair slots s0 .. s1 - 1 (slot s joins pair_i[s] < pair_j[s]): w[s] = W(h, r), 0 for
+/// r >= 2h, and the interacting slots (0 < r < 2h), in slot order, with their ends into
+/// act_i/act_j/act_slot from index s0 on. Returns how many there are.
+using ActivePairsFn = std::size_t (*)(const Vec3* x, const uint32_t* pair_i, const uint32_t* pair_j,
+                                      const HairPairConsts& c, std::size_t s0, std::size_t s1,
+                                      double* w, uint32_t* act_i, uint32_t* act_j,
+                                      uint32_t* act_slot);
+
+/// Inputs of the direction update (3.15) from the cached connection geometry: each particle's
+/// connections by role (CSR; ts = it is the root-side end, rs = the tip-side end) with cos/sin
+/// theta0 of its own end, and per connection |x_ab|, x^_ab, alpha_ij and k_ij.
+struct DirectionInputs {
+  const uint32_t *ts_off = nullptr, *ts_pairs = nullptr, *rs_off = nullptr, *rs_pairs = nullptr;
+  const double *ts_cos = nullptr, *ts_sin = nullptr, *rs_cos = nullptr, *rs_sin = nullptr;
+  const double* conn_r = nullptr;
+  const Vec3* conn_xh = nullptr;
+  const double *alpha = nullptr, *k = nullptr;
+  const uint8_t* root = nullptr;
+};
+
+/// (3.15) new direction t_i of every non-root particle i0 <= i < i1 (t is read and written).
+using DirectionsFn = void (*)(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t);
+
+/// Inputs of the force gather: each particle's connections by role (as DirectionInputs) with
+/// the spring force on the root-side end per connection, and with hair-hair interaction (hh)
+/// the sorted neighbour lists (nbr_off, nbr_upper: first entry above the particle's own index,
+/// nbr_pair: pair slot of each entry, pair_off: first pair slot of each particle) with the
+/// force on the lower-index end per pair slot.
+struct GatherInputs {
+  const uint32_t *ts_off = nullptr, *ts_pairs = nullptr, *rs_off = nullptr, *rs_pairs = nullptr;
+  const Vec3* spring_f = nullptr;
+  bool hh = false;
+  const uint32_t *nbr_off = nullptr, *nbr_upper = nullptr, *nbr_pair = nullptr, *pair_off = nullptr;
+  const Vec3* pair_f = nullptr;
+};
+
+/// Total internal force on every particle i0 <= i < i1 into force[i], summed in a fixed order:
+/// + springs where i is the root-side end, - where it is the tip-side end, - pairs with a
+/// lower-index partner, + pairs with a higher-index one.
+using GatherFn = void (*)(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force);
+
+struct LcpKernels {
+  ActivePairsFn active = nullptr;
+  HairPairBatchFn forces = nullptr;
+  DirectionsFn directions = nullptr;
+  GatherFn gather = nullptr;
+  bool simd = false;  // the AVX2 kernels
+};
+
+/// The fastest kernels this CPU runs (AVX2, else the scalar loops); `allow_simd = false` always
+/// gives the scalar loops.
+LcpKernels lcp_kernels(bool allow_simd = true);
+
+}  // namespace follicle::hair::detail
