@@ -708,22 +708,24 @@ void LcpSolver::pair_forces(const Context& ctx, const LcpState& s, LcpWorkspace&
   pair_forces_sorted(ctx, s, ws);
 }
 
-void LcpSolver::spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, double r,
-                          const Vec3& xh) const {
-  // Loose spring, once per connection: force on the root-side end a (b gets the negation).
-  const auto& m = m_model;
-  const auto& p = m_params;
-  if (!(r > 0)) {
-    ws.spring_f[q] = Vec3::Zero();
-    return;
+detail::SpringInputs LcpSolver::spring_inputs(const LcpState& s, LcpWorkspace& ws,
+                                              bool with_alpha) const {
+  detail::SpringInputs in;
+  in.pair_a = m_model.pair_a.data();
+  in.pair_b = m_model.pair_b.data();
+  in.l0 = m_model.l0.data();
+  in.damp = m_damp.data();
+  in.conn_r = ws.conn_r.data();
+  in.conn_xh = ws.conn_xh.data();
+  in.k = ws.k.data();
+  in.alpha = ws.alpha.data();
+  if (with_alpha) {
+    in.alpha_r = ws.alpha_r.data();
+    in.alpha_t = ws.alpha_t.data();
   }
-  const uint32_t a = m.pair_a[q], b = m.pair_b[q];
-  const double ak = ws.alpha[q] * ws.k[q];  // current coefficient alpha_ij k_ij
-  const double ext = r - m.l0[q];
-  // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
-  const double kk = ext < 0 ? ak * p.compression_scale : ak;
-  const double cd = m_damp[q] * std::sqrt(kk);  // 2 zeta sqrt(k mu), critical damping ratio zeta
-  ws.spring_f[q] = (kk * ext + cd * (s.v[b] - s.v[a]).dot(xh)) * xh;
+  in.v = s.v.data();
+  in.compression_scale = m_params.compression_scale;
+  return in;
 }
 
 void LcpSolver::active_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
@@ -789,10 +791,13 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
   const std::size_t n = m.size(), np = m.num_pairs();
   ws.force.resize(n);
   ws.spring_f.resize(np);
-  parallel_for(ctx, 0, np, [&](std::size_t q) {
-    const Vec3 d = s.x[m.pair_b[q]] - s.x[m.pair_a[q]];
-    const double r = d.norm();
-    spring_of(q, s, ws, r, r > 0 ? Vec3(d / r) : Vec3::Zero());
+  ws.conn_r.resize(np);
+  ws.conn_xh.resize(np);
+  ws.geom_owner = nullptr;  // the geometry below is not step()'s cache
+  const detail::SpringInputs sin = spring_inputs(s, ws, false);
+  parallel_chunks(ctx, np, kChunk, [&](std::size_t q0, std::size_t q1) {
+    for (std::size_t q = q0; q < q1; ++q) geometry_of(q, s, ws);
+    detail::lcp_springs(sin, q0, q1, ws.spring_f.data());
   });
   const bool hh = p.hair_hair && ws.nbr_offsets.size() == n + 1 && ws.density.size() == n &&
                   ws.pressure.size() == n && ws.nbr_mirror.size() == ws.nbrs.size() &&
@@ -815,7 +820,7 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
   }
   const detail::GatherInputs gin = gather_inputs(ws, hh);
   parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
-    m_kernels.gather(gin, i0, i1, ws.force.data());
+    detail::lcp_gather(gin, i0, i1, ws.force.data());
   });
 }
 
@@ -863,7 +868,7 @@ void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWork
   });
   const detail::DirectionInputs din = direction_inputs(r.data(), xh.data(), ws);
   parallel_chunks(ctx, m.size(), kChunk, [&](std::size_t i0, std::size_t i1) {
-    m_kernels.directions(din, i0, i1, s.t.data());
+    detail::lcp_directions(din, i0, i1, s.t.data());
   });
 }
 
@@ -1008,15 +1013,12 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     // 3. alpha (3.14) and springs once per connection (indices 0 .. np - 1), hair-hair forces
     // once per pair (particle i at index np + i): one parallel loop over both.
     const std::size_t nconn = (np + kChunk - 1) / kChunk;
+    const detail::SpringInputs sin = spring_inputs(s, ws, alpha_here);  // (3.14) if alpha_here
     parallel_for(
         ctx, 0, nconn + (hh ? nchunks : 0),
         [&](std::size_t c) {
           if (c >= nconn) return hair_pairs_of(c - nconn, s, ws, pc);
-          for (std::size_t k = c * kChunk; k < std::min(np, (c + 1) * kChunk); ++k) {
-            if (alpha_here)  // (3.14): a is root-side (in N_r(b)), b is tip-side (in N_t(a))
-              ws.alpha[k] = 0.5 * (ws.alpha_r[m.pair_b[k]] + ws.alpha_t[m.pair_a[k]]);
-            spring_of(k, s, ws, ws.conn_r[k], ws.conn_xh[k]);
-          }
+          detail::lcp_springs(sin, c * kChunk, std::min(np, (c + 1) * kChunk), ws.spring_f.data());
         },
         1);
     // 4. Gather, accelerations and the leapfrog update (each particle reads only its own state
@@ -1024,7 +1026,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     // v(t + dt/2) dt.
     const detail::GatherInputs gin = gather_inputs(ws, hh);
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
-      m_kernels.gather(gin, i0, i1, ws.force.data());
+      detail::lcp_gather(gin, i0, i1, ws.force.data());
       for (std::size_t i = i0; i < i1; ++i) {
         const Vec3 force = ws.force[i];
         if (m.root[i]) {
@@ -1067,7 +1069,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     const double vlim = P.max_speed;
     const detail::DirectionInputs din = direction_inputs(ws.conn_r.data(), ws.conn_xh.data(), ws);
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
-      m_kernels.directions(din, i0, i1, s.t.data());  // (3.15)
+      detail::lcp_directions(din, i0, i1, s.t.data());  // (3.15)
       LcpWorkspace::ChunkCheck c;
       for (std::size_t i = i0; i < i1; ++i) {
         const double sp = s.v[i].norm();

@@ -282,8 +282,7 @@ class LcpSolver {
   void alpha_sums_of(std::size_t i, LcpWorkspace& ws) const;
   void alpha_of(std::size_t i, LcpWorkspace& ws) const;
   void alpha_sweeps(const Context& ctx, LcpWorkspace& ws) const;
-  void spring_of(std::size_t q, const LcpState& s, LcpWorkspace& ws, double r,
-                 const Vec3& xh) const;
+  detail::SpringInputs spring_inputs(const LcpState& s, LcpWorkspace& ws, bool with_alpha) const;
   void active_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
                        const detail::HairPairConsts& pc) const;
   static void pair_scratch(LcpWorkspace& ws);

@@ -55,6 +55,19 @@ Vec3 hair_pair_force(const HairPairInputs& in, const HairPairConsts& c, uint32_t
   return f;
 }
 
+Vec3 spring_force(const SpringInputs& in, std::size_t q) {
+  // Loose spring with damping.
+  const double r = in.conn_r[q];
+  if (!(r > 0)) return Vec3::Zero();
+  const Vec3 xh = in.conn_xh[q];
+  const double ak = in.alpha[q] * in.k[q];  // current coefficient alpha_ij k_ij
+  const double ext = r - in.l0[q];
+  // Compressed springs are scaled: bending stiffness relative to tensile stiffness (§3.3.2).
+  const double kk = ext < 0 ? ak * in.compression_scale : ak;
+  const double cd = in.damp[q] * std::sqrt(kk);  // 2 zeta sqrt(k mu), critical damping ratio zeta
+  return (kk * ext + cd * (in.v[in.pair_b[q]] - in.v[in.pair_a[q]]).dot(xh)) * xh;
+}
+
 namespace {
 
 // Slots s0 .. s1 - 1, the interacting ones written from index out on; returns the index after
@@ -93,7 +106,9 @@ void batch_scalar(const HairPairInputs& in, const HairPairConsts& c, const uint3
   for (std::size_t k = 0; k < count; ++k) out[slot[k]] = hair_pair_force(in, c, i[k], j[k]);
 }
 
-void directions_scalar(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t) {
+}  // namespace
+
+void lcp_directions(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t) {
   for (std::size_t i = i0; i < i1; ++i) {
     if (in.root[i]) continue;
     const Vec3 ti = t[i];
@@ -103,7 +118,7 @@ void directions_scalar(const DirectionInputs& in, std::size_t i0, std::size_t i1
     // Summed as acc = sum_j [a_j x^_j] + b t_i with scalar a_j = ak (cos0 - sin0 (t_i . x^) / p_j)
     // and b = sum_j ak sin0 / p_j (p_j = |t_i - (t_i . x^) x^|; the sin0 part drops when p_j
     // vanishes, x^ parallel to t_i). sign = +1 where i is the root-side end a (x_ij = x_ab),
-    // -1 where it is the tip-side end b. Mirrored operation for operation by avx2::directions.
+    // -1 where it is the tip-side end b.
     Vec3 acc = Vec3::Zero();
     double bsum = 0;
     auto add = [&](uint32_t q, double sign, double c0, double s0) {
@@ -127,9 +142,17 @@ void directions_scalar(const DirectionInputs& in, std::size_t i0, std::size_t i1
   }
 }
 
-void gather_scalar(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force) {
+void lcp_springs(const SpringInputs& in, std::size_t q0, std::size_t q1, Vec3* spring_f) {
+  for (std::size_t q = q0; q < q1; ++q) {
+    if (in.alpha_r)  // (3.14): a is root-side (in N_r(b)), b is tip-side (in N_t(a))
+      in.alpha[q] = 0.5 * (in.alpha_r[in.pair_b[q]] + in.alpha_t[in.pair_a[q]]);
+    spring_f[q] = spring_force(in, q);
+  }
+}
+
+void lcp_gather(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force) {
   // A fixed order: deterministic for any thread count, and each pair's two contributions are
-  // exact negations. Mirrored by avx2::gather.
+  // exact negations.
   for (std::size_t i = i0; i < i1; ++i) {
     Vec3 f = Vec3::Zero();
     for (uint32_t e = in.ts_off[i]; e < in.ts_off[i + 1]; ++e) f += in.spring_f[in.ts_pairs[e]];
@@ -144,8 +167,6 @@ void gather_scalar(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3*
     force[i] = f;
   }
 }
-
-}  // namespace
 
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
 #pragma GCC push_options
@@ -271,142 +292,16 @@ std::size_t active(const Vec3* x, const uint32_t* pair_i, const uint32_t* pair_j
   return active_from(x, pair_i, pair_j, c, s, s1, w, act_i, act_j, act_slot, cnt) - s0;
 }
 
-void directions(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t) {
-  // Four particles at a time, one per lane; each lane adds its own connection ends in the
-  // scalar order (ts list, then rs list), lanes without an end at step k keep their sums.
-  const double* T = t->data();
-  const double* XH = in.conn_xh->data();
-  const V zero = splat(0.0), tiny = splat(1e-12), huge = splat(1e-300);
-  const V inf = splat(std::numeric_limits<double>::infinity());
-  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
-  std::size_t i = i0;
-  for (; i + 4 <= i1; i += 4) {
-    uint32_t roots;
-    std::memcpy(&roots, in.root + i, 4);
-    if (roots == 0x01010101u) continue;
-    const __m128i ii = _mm_add_epi32(_mm_set1_epi32(int(i)), lane);
-    const __m128i i3 = _mm_add_epi32(_mm_add_epi32(ii, ii), ii);
-    const V tx = gather(T, i3, 0), ty = gather(T, i3, 1), tz = gather(T, i3, 2);
-    V ax = zero, ay = zero, az = zero, bsum = zero;
-    for (int role = 0; role < 2; ++role) {
-      const uint32_t* off = role == 0 ? in.ts_off : in.rs_off;
-      const uint32_t* pairs = role == 0 ? in.ts_pairs : in.rs_pairs;
-      const double* cs = role == 0 ? in.ts_cos : in.rs_cos;
-      const double* sn = role == 0 ? in.ts_sin : in.rs_sin;
-      const V sign = splat(role == 0 ? 1.0 : -1.0);
-      const __m128i e0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(off + i));
-      const __m128i len =
-          _mm_sub_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(off + i + 1)), e0);
-      alignas(16) uint32_t lens[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(lens), len);
-      const uint32_t kmax = std::max(std::max(lens[0], lens[1]), std::max(lens[2], lens[3]));
-      for (uint32_t k = 0; k < kmax; ++k) {
-        const __m128i kk = _mm_set1_epi32(int(k));
-        const __m128i on32 = _mm_cmpgt_epi32(len, kk);  // k < len (lengths < 2^31)
-        const __m256d on64 = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(on32));
-        const __m128i e = _mm_add_epi32(e0, kk);
-        const __m128i q = _mm_mask_i32gather_epi32(_mm_setzero_si128(),
-                                                   reinterpret_cast<const int*>(pairs), e, on32, 4);
-        const __m128i q3 = _mm_add_epi32(_mm_add_epi32(q, q), q);
-        const V c0 = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), cs, e, on64, 8));
-        const V s0 = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), sn, e, on64, 8));
-        const V r = gather1(in.conn_r, q);
-        const V xx = sign * gather(XH, q3, 0), xy = sign * gather(XH, q3, 1),
-                xz = sign * gather(XH, q3, 2);
-        const V ak = gather1(in.alpha, q) * gather1(in.k, q);
-        const V d = tx * xx + ty * xy + tz * xz;
-        const V px = tx - d * xx, py = ty - d * xy, pz = tz - d * xz;
-        const V pn = vsqrt(px * px + py * py + pz * pz);
-        const V sp = pn > tiny ? ak * s0 / pn : zero;
-        const V coef = ak * c0 - sp * d;
-        const auto valid = (V(on64) != zero) & (r > zero);
-        ax = valid ? ax + coef * xx : ax;
-        ay = valid ? ay + coef * xy : ay;
-        az = valid ? az + coef * xz : az;
-        bsum = valid ? bsum + sp : bsum;
-      }
-    }
-    ax = ax + bsum * tx;
-    ay = ay + bsum * ty;
-    az = az + bsum * tz;
-    const V an = vsqrt(ax * ax + ay * ay + az * az);
-    const auto ok = (an > huge) & (an < inf);
-    const V nx = ax / an, ny = ay / an, nz = az / an;
-    for (int l = 0; l < 4; ++l)
-      if (!in.root[i + std::size_t(l)] && ok[l]) t[i + std::size_t(l)] = Vec3(nx[l], ny[l], nz[l]);
-  }
-  directions_scalar(in, i, i1, t);
-}
-
-// Adds (or subtracts) src[index[start + k]] (src[start + k] without index) for k < len, lane by
-// lane in k order; a lane past its length keeps its sum.
-inline void accumulate(const double* src, const uint32_t* index, __m128i start, __m128i len,
-                       bool subtract, V& fx, V& fy, V& fz) {
-  alignas(16) uint32_t lens[4];
-  _mm_store_si128(reinterpret_cast<__m128i*>(lens), len);
-  const uint32_t kmax = std::max(std::max(lens[0], lens[1]), std::max(lens[2], lens[3]));
-  for (uint32_t k = 0; k < kmax; ++k) {
-    const __m128i kk = _mm_set1_epi32(int(k));
-    const __m128i on32 = _mm_cmpgt_epi32(len, kk);
-    const __m256d on64 = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(on32));
-    __m128i q = _mm_add_epi32(start, kk);
-    if (index)
-      q = _mm_mask_i32gather_epi32(_mm_setzero_si128(), reinterpret_cast<const int*>(index), q,
-                                   on32, 4);
-    const __m128i q3 = _mm_add_epi32(_mm_add_epi32(q, q), q);
-    const V x = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), src, q3, on64, 8));
-    const V y = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), src + 1, q3, on64, 8));
-    const V z = V(_mm256_mask_i32gather_pd(_mm256_setzero_pd(), src + 2, q3, on64, 8));
-    const auto on = V(on64) != splat(0.0);
-    if (subtract) {
-      fx = on ? fx - x : fx;
-      fy = on ? fy - y : fy;
-      fz = on ? fz - z : fz;
-    } else {
-      fx = on ? fx + x : fx;
-      fy = on ? fy + y : fy;
-      fz = on ? fz + z : fz;
-    }
-  }
-}
-
-inline __m128i load4(const uint32_t* p) {
-  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
-}
-
-void gather(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force) {
-  // Four particles at a time, one per lane, each summing in the scalar order.
-  const double* SF = in.spring_f->data();
-  const double* PF = in.hh ? in.pair_f->data() : nullptr;
-  std::size_t i = i0;
-  for (; i + 4 <= i1; i += 4) {
-    V fx = splat(0.0), fy = splat(0.0), fz = splat(0.0);
-    __m128i a = load4(in.ts_off + i);
-    accumulate(SF, in.ts_pairs, a, _mm_sub_epi32(load4(in.ts_off + i + 1), a), false, fx, fy, fz);
-    a = load4(in.rs_off + i);
-    accumulate(SF, in.rs_pairs, a, _mm_sub_epi32(load4(in.rs_off + i + 1), a), true, fx, fy, fz);
-    if (in.hh) {
-      const __m128i e0 = load4(in.nbr_off + i), eu = load4(in.nbr_upper + i);
-      accumulate(PF, in.nbr_pair, e0, _mm_sub_epi32(eu, e0), true, fx, fy, fz);
-      accumulate(PF, nullptr, load4(in.pair_off + i), _mm_sub_epi32(load4(in.nbr_off + i + 1), eu),
-                 false, fx, fy, fz);
-    }
-    for (int l = 0; l < 4; ++l) force[i + std::size_t(l)] = Vec3(fx[l], fy[l], fz[l]);
-  }
-  gather_scalar(in, i, i1, force);
-}
-
 }  // namespace avx2
 #pragma GCC pop_options
 #endif
 
 LcpKernels lcp_kernels(bool allow_simd) {
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
-  if (allow_simd && __builtin_cpu_supports("avx2"))
-    return {&avx2::active, &avx2::batch, &avx2::directions, &avx2::gather, true};
+  if (allow_simd && __builtin_cpu_supports("avx2")) return {&avx2::active, &avx2::batch, true};
 #endif
   (void)allow_simd;
-  return {&active_scalar, &batch_scalar, &directions_scalar, &gather_scalar, false};
+  return {&active_scalar, &batch_scalar, false};
 }
 
 }  // namespace follicle::hair::detail

@@ -1,12 +1,13 @@
 #pragma once
-// Inner kernels of the loosely connected particles' sub-step (Bando 2003): for the hair-hair
-// pairs (§3.3.3) the kernel W(h, r) of every listed pair with the selection of the interacting
-// ones (0 < r < 2h) and the pair force (3.16)-(3.18); the hair direction update (3.15). Each has
-// a scalar reference and a batch version that uses AVX2 (4 pairs or 4 particles per
+// Inner kernels of the loosely connected particles' sub-step (Bando 2003), over flat ranges of
+// particles, connections or pair slots. For the hair-hair pairs (§3.3.3), the kernel W(h, r) of
+// every listed pair with the selection of the interacting ones (0 < r < 2h) and the pair force
+// (3.16)-(3.18) each have a scalar reference and a batch version that uses AVX2 (4 pairs per
 // instruction, double precision) when the CPU has it. The AVX2 versions perform the same IEEE
 // operations in the same order as the scalar code, lane by lane (no FMA, no reduction across
 // lanes), so both give the same bits; the solver's results do not depend on which runs
-// (ADR 0008).
+// (ADR 0008). The springs, the force gather and the direction update (3.15) are scalar: AVX2
+// versions with one particle or connection per lane were measured and gave nothing (ADR 0008).
 #include <cstddef>
 #include <cstdint>
 
@@ -64,7 +65,7 @@ struct DirectionInputs {
 };
 
 /// (3.15) new direction t_i of every non-root particle i0 <= i < i1 (t is read and written).
-using DirectionsFn = void (*)(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t);
+void lcp_directions(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t);
 
 /// Inputs of the force gather: each particle's connections by role (as DirectionInputs) with
 /// the spring force on the root-side end per connection, and with hair-hair interaction (hh)
@@ -82,13 +83,30 @@ struct GatherInputs {
 /// Total internal force on every particle i0 <= i < i1 into force[i], summed in a fixed order:
 /// + springs where i is the root-side end, - where it is the tip-side end, - pairs with a
 /// lower-index partner, + pairs with a higher-index one.
-using GatherFn = void (*)(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force);
+void lcp_gather(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* force);
+
+/// Inputs of the loose springs (§3.3.2), one per connection a -> b: the cached geometry |x_ab|,
+/// x^_ab, rest length l0, damping factor 2 zeta sqrt(mu_ab), k_ij (3.7) and alpha_ij; with
+/// alpha_r/alpha_t set, alpha_ij is first computed by (3.14) from the per-particle (3.13) sums.
+struct SpringInputs {
+  const uint32_t *pair_a = nullptr, *pair_b = nullptr;
+  const double *l0 = nullptr, *damp = nullptr, *conn_r = nullptr, *k = nullptr;
+  const Vec3* conn_xh = nullptr;
+  double* alpha = nullptr;
+  const double *alpha_r = nullptr, *alpha_t = nullptr;  // null: alpha is already set
+  const Vec3* v = nullptr;
+  double compression_scale = 1;
+};
+
+/// Spring force on the root-side end a of connection q (b gets the negation); zero for r <= 0.
+Vec3 spring_force(const SpringInputs& in, std::size_t q);
+
+/// alpha_ij (3.14) when requested and spring_f[q] = spring_force(q) for q0 <= q < q1.
+void lcp_springs(const SpringInputs& in, std::size_t q0, std::size_t q1, Vec3* spring_f);
 
 struct LcpKernels {
   ActivePairsFn active = nullptr;
   HairPairBatchFn forces = nullptr;
-  DirectionsFn directions = nullptr;
-  GatherFn gather = nullptr;
   bool simd = false;  // the AVX2 kernels
 };
 

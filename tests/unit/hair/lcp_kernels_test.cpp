@@ -219,81 +219,51 @@ TEST(LcpKernels, SolverTrajectoriesDoNotDependOnTheKernel) {
       0.0);
 }
 
-TEST(LcpKernels, DirectionKernelGivesTheScalarBits) {
-  // (3.15) over random particles with 0..9 connection ends of each role (lanes of one block end
-  // at different steps), root particles (left unchanged), connections of zero length (skipped),
-  // ends whose x^ is parallel to t_i (the sin part drops) and a particle without connections.
-  const auto simd = detail::lcp_kernels(true), ref = detail::lcp_kernels(false);
-  if (!simd.simd) GTEST_SKIP() << "no AVX2 on this CPU";
-  std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const std::size_t n = 203, np = 400;
-  std::vector<double> r(np), alpha(np), k(np);
-  std::vector<Vec3> xh(np), t(n);
-  for (std::size_t q = 0; q < np; ++q) {
-    xh[q] = Vec3(u(rng), u(rng), u(rng)).normalized();
-    r[q] = q % 37 == 5 ? 0.0 : 0.01 * (1.5 + u(rng));
-    alpha[q] = 1 + u(rng) * 0.5;
-    k[q] = q % 11 == 3 ? 0.0 : 100 * (1.5 + u(rng));
-  }
-  std::vector<uint8_t> root(n);
-  std::vector<uint32_t> off[2], pairs[2];
-  std::vector<double> cs[2], sn[2];
-  for (std::size_t i = 0; i < n; ++i) {
-    t[i] = Vec3(u(rng), u(rng), u(rng)).normalized();
-    root[i] = i % 9 == 4 ? 1 : 0;
-    for (int role = 0; role < 2; ++role) {
-      if (off[role].empty()) off[role].push_back(0);
-      const std::size_t cnt = i == 100 ? 0 : rng() % 10;
-      for (std::size_t e = 0; e < cnt; ++e) {
-        const uint32_t q = uint32_t(rng() % np);
-        pairs[role].push_back(q);
-        const double c0 = 0.3 + 0.6 * (0.5 + 0.5 * u(rng));
-        cs[role].push_back(role == 0 ? c0 : -c0);
-        sn[role].push_back(std::sqrt(1 - c0 * c0));
-      }
-      off[role].push_back(uint32_t(pairs[role].size()));
-    }
-  }
-  t[7] = xh[pairs[0][off[0][7]]];  // an end with x^ parallel to t_i: p_j = 0
+TEST(LcpKernels, DirectionUpdateFollowsItsConnections) {
+  // (3.15) with theta0 = 0 at every end (cos 1, sin 0): t_i^j = x^_ij, so a particle whose ends
+  // all point along one unit vector gets exactly that direction (sign -1 at the tip-side end);
+  // zero-length connections are skipped; root particles and particles without connections
+  // keep their direction; with theta0 = 90 degrees and t_i normal to x^ the direction stays.
+  const Vec3 e = Vec3(1, 2, 2) / 3.0;
+  std::vector<double> r{0.01, 0.02, 0.0, 0.01}, alpha{1, 2, 1, 1},
+      k{3, 5, 5, 1};  // q1 outweighs q0: a wrong sign flips t
+  std::vector<Vec3> xh{e, -e, Vec3::UnitX(), Vec3::UnitZ()};
+  std::vector<uint8_t> root{0, 1, 0, 0, 0};
+  // Particle 0: root-side end of q0 (x^ = e) and tip-side end of q1 (x^_ij = -(-e) = e), plus
+  // the zero-length q2. Particle 1: a root. Particle 2: none. Particle 3: tip-side end of q3 at
+  // 90 degrees.
+  std::vector<uint32_t> ts_off{0, 2, 2, 2, 2, 2}, ts_pairs{0, 2}, rs_off{0, 1, 2, 2, 3, 3},
+      rs_pairs{1, 0, 3};
+  std::vector<double> ts_cos{1, 1}, ts_sin{0, 0}, rs_cos{1, 1, 0}, rs_sin{0, 0, 1};
   detail::DirectionInputs in;
-  in.ts_off = off[0].data();
-  in.ts_pairs = pairs[0].data();
-  in.ts_cos = cs[0].data();
-  in.ts_sin = sn[0].data();
-  in.rs_off = off[1].data();
-  in.rs_pairs = pairs[1].data();
-  in.rs_cos = cs[1].data();
-  in.rs_sin = sn[1].data();
+  in.ts_off = ts_off.data();
+  in.ts_pairs = ts_pairs.data();
+  in.ts_cos = ts_cos.data();
+  in.ts_sin = ts_sin.data();
+  in.rs_off = rs_off.data();
+  in.rs_pairs = rs_pairs.data();
+  in.rs_cos = rs_cos.data();
+  in.rs_sin = rs_sin.data();
   in.conn_r = r.data();
   in.conn_xh = xh.data();
   in.alpha = alpha.data();
   in.k = k.data();
   in.root = root.data();
-  std::vector<Vec3> ta = t, tb = t;
-  simd.directions(in, 1, n, ta.data());  // from 1: blocks at an odd start, remainder of 2
-  ref.directions(in, 1, n, tb.data());
-  int changed = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    ASSERT_TRUE(same_bits(ta[i], tb[i]))
-        << i << ": " << ta[i].transpose() << " vs " << tb[i].transpose();
-    if (root[i] || i == 0 || i == 100) {
-      EXPECT_TRUE(same_bits(ta[i], t[i])) << i;  // roots, outside the range, no connection
-    } else {
-      EXPECT_NEAR(ta[i].norm(), 1.0, 1e-12) << i;
-      changed += !same_bits(ta[i], t[i]);
-    }
-  }
-  EXPECT_GT(changed, 150);
+  const Vec3 t0 = Vec3(0, 0, 1), t3 = Vec3(1, 0, 0);
+  std::vector<Vec3> t{t0, Vec3::UnitY(), Vec3::UnitY(), t3, Vec3::UnitX()};
+  detail::lcp_directions(in, 0, 4, t.data());
+  EXPECT_LT((t[0] - e).norm(), 1e-15);
+  EXPECT_TRUE(t[1] == Vec3::UnitY());
+  EXPECT_TRUE(t[2] == Vec3::UnitY());
+  // q3 seen from its tip-side end: x^_ij = -z; theta0 = 90 degrees in the plane of t and x^.
+  EXPECT_LT((t[3] - t3).norm(), 1e-15);
+  EXPECT_TRUE(t[4] == Vec3::UnitX());  // outside the range
 }
 
-TEST(LcpKernels, GatherKernelGivesTheScalarBitsAndBalancesEveryPair) {
-  // Random particles with 0..9 connection ends of each role and 0..9 lower and upper list
-  // entries, with and without hair-hair lists: the AVX2 gather gives the scalar bits, and the
-  // forces of all particles sum to zero up to rounding (every spring and pair enters once with
-  // each sign).
-  const auto simd = detail::lcp_kernels(true), ref = detail::lcp_kernels(false);
-  if (!simd.simd) GTEST_SKIP() << "no AVX2 on this CPU";
+TEST(LcpKernels, GatherBalancesEveryPairAndSpring) {
+  // Random particles with connection ends of each role and lower and upper list entries, with
+  // and without hair-hair lists: each particle's force is its springs and pairs with the right
+  // signs, and the forces of all particles sum to zero up to rounding.
   std::mt19937_64 rng(23);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const std::size_t n = 150;
@@ -361,12 +331,17 @@ TEST(LcpKernels, GatherKernelGivesTheScalarBitsAndBalancesEveryPair) {
     in.nbr_pair = nbr_pair.data();
     in.pair_off = pair_off.data();
     in.pair_f = pair_f.data();
-    std::vector<Vec3> fa(n, Vec3::Constant(9)), fb(n, Vec3::Constant(9));
-    simd.gather(in, 3, n, fa.data());  // from 3: blocks at an odd start, remainder of 3
-    ref.gather(in, 3, n, fb.data());
-    for (std::size_t i = 0; i < n; ++i)
-      ASSERT_TRUE(same_bits(fa[i], fb[i])) << "hh " << hh << ", particle " << i;
-    ref.gather(in, 0, 3, fb.data());
+    std::vector<Vec3> fb(n, Vec3::Constant(9));
+    detail::lcp_gather(in, 0, n, fb.data());
+    for (std::size_t i = 0; i < n; ++i) {  // the same sum written out
+      Vec3 f = Vec3::Zero();
+      for (uint32_t q : ts[i]) f += spring_f[q];
+      for (uint32_t q : rs[i]) f -= spring_f[q];
+      if (hh)
+        for (const auto& e : lists[i])
+          f += e.first > i ? pair_f[e.second] : Vec3(-pair_f[e.second]);
+      EXPECT_LT((fb[i] - f).norm(), 1e-12) << "hh " << hh << ", particle " << i;
+    }
     Vec3 total = Vec3::Zero();
     double scale = 0;
     for (const auto& f : fb) {
@@ -374,5 +349,73 @@ TEST(LcpKernels, GatherKernelGivesTheScalarBitsAndBalancesEveryPair) {
       scale += f.norm();
     }
     EXPECT_LT(total.norm(), 1e-12 * scale) << "hh " << hh;
+  }
+}
+
+TEST(LcpKernels, SpringsStretchCompressAndDamp) {
+  // Stretched and compressed springs (compression scale), zero-length connections (no force),
+  // with and without the alpha update (3.14): each force equals the damped spring along x^ with
+  // the scaled stiffness when compressed, and a spring at rest with equal end velocities exerts
+  // no force.
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::size_t n = 80, np = 203;
+  std::vector<uint32_t> pa(np), pb(np);
+  std::vector<double> l0(np), damp(np), r(np), k(np), ar(n), at(n);
+  std::vector<Vec3> xh(np), v(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    v[i] = Vec3(u(rng), u(rng), u(rng));
+    ar[i] = 1 + 0.5 * u(rng);
+    at[i] = 1 + 0.5 * u(rng);
+  }
+  for (std::size_t q = 0; q < np; ++q) {
+    pa[q] = uint32_t(rng() % n);
+    pb[q] = uint32_t((pa[q] + 1 + rng() % (n - 1)) % n);
+    l0[q] = 0.01 * (1.5 + u(rng));
+    r[q] = q % 13 == 2 ? 0.0 : l0[q] * (1 + 0.3 * u(rng));
+    damp[q] = 1e-3 * (1.5 + u(rng));
+    k[q] = 50 * (1.5 + u(rng));
+    xh[q] = Vec3(u(rng), u(rng), u(rng)).normalized();
+  }
+  r[7] = l0[7];         // at rest ...
+  v[pb[7]] = v[pa[7]];  // ... with equal end velocities
+  for (int with_alpha = 0; with_alpha < 2; ++with_alpha) {
+    std::vector<double> alpha_a(np, 1.25);
+    detail::SpringInputs in;
+    in.pair_a = pa.data();
+    in.pair_b = pb.data();
+    in.l0 = l0.data();
+    in.damp = damp.data();
+    in.conn_r = r.data();
+    in.conn_xh = xh.data();
+    in.k = k.data();
+    in.v = v.data();
+    in.compression_scale = 0.25;
+    if (with_alpha) {
+      in.alpha_r = ar.data();
+      in.alpha_t = at.data();
+    }
+    std::vector<Vec3> fa(np, Vec3::Constant(5));
+    in.alpha = alpha_a.data();
+    detail::lcp_springs(in, 1, np, fa.data());
+    EXPECT_TRUE(fa[0] == Vec3::Constant(5));  // outside the range
+    int compressed = 0;
+    for (std::size_t q = 1; q < np; ++q) {
+      const double ak = alpha_a[q] * k[q], ext = r[q] - l0[q];
+      const double kk = ext < 0 ? 0.25 * ak : ak;
+      const double dv = (v[pb[q]] - v[pa[q]]).dot(xh[q]);
+      if (r[q] > 0) {
+        EXPECT_LT((fa[q] - (kk * ext + damp[q] * std::sqrt(kk) * dv) * xh[q]).norm(), 1e-12) << q;
+      }
+      if (with_alpha) {
+        EXPECT_EQ(alpha_a[q], 0.5 * (ar[pb[q]] + at[pa[q]]));
+      }
+      if (r[q] == 0) {
+        EXPECT_TRUE(fa[q] == Vec3::Zero());
+      }
+      compressed += r[q] > 0 && r[q] < l0[q];
+    }
+    EXPECT_TRUE(fa[7] == Vec3::Zero());
+    EXPECT_GT(compressed, 40);
   }
 }
