@@ -744,9 +744,7 @@ void LcpSolver::active_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& 
 
 detail::HairPairConsts LcpSolver::pair_consts(const SphKernel& K, double inv_w0) const {
   detail::HairPairConsts c;
-  c.inv_h = K.inv_h;
-  c.sigma_w = K.sigma_w;
-  c.sigma_dw = K.sigma_dw;
+  c.kernel = K;
   c.inv_w0 = inv_w0;
   c.r2max = 4 * m_model.h * m_model.h;
   c.eps2 = m_params.colinear_eps * m_params.colinear_eps;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <limits>
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -20,11 +19,8 @@ Vec3 hair_pair_force(const HairPairInputs& in, const HairPairConsts& c, uint32_t
   const Vec3 xab = in.x[j] - xi;
   const double r = std::sqrt(xab.squaredNorm());
   const Vec3 xh = xab * (1.0 / r);
-  // Monaghan's kernel as in SphKernel::w_dw.
-  const double q = r * c.inv_h;
-  const double a = std::max(2.0 - q, 0.0), b = std::max(1.0 - q, 0.0);
-  const double w = c.sigma_w * 0.25 * (a * a * a - 4.0 * b * b * b);
-  const double dw = c.sigma_dw * 0.75 * (4.0 * b * b - a * a);
+  double w, dw;
+  c.kernel.w_dw(r, w, dw);
   const double mj = in.mass[j];
   // (3.16) SPH pressure force: -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) dW/dx_i,
   // dW/dx_i = -W' x^_ij
@@ -81,10 +77,7 @@ std::size_t active_from(const Vec3* x, const uint32_t* pair_i, const uint32_t* p
   for (std::size_t s = s0; s < s1; ++s) {
     const uint32_t i = pair_i[s], j = pair_j[s];
     const double d2 = (x[j] - x[i]).squaredNorm();
-    // Monaghan's kernel as in SphKernel::w.
-    const double q = std::sqrt(d2) * c.inv_h;
-    const double a = std::max(2.0 - q, 0.0), b = std::max(1.0 - q, 0.0);
-    const double wk = c.sigma_w * 0.25 * (a * a * a - 4.0 * b * b * b);
+    const double wk = c.kernel.w(std::sqrt(d2));
     const bool inside = d2 < c.r2max;
     w[s] = inside ? wk : 0.0;
     act_i[cnt] = i;
@@ -201,7 +194,8 @@ void batch(const HairPairInputs& in, const HairPairConsts& c, const uint32_t* I,
   const double* Vv = in.v->data();
   const double* T = in.t->data();
   const V zero = splat(0.0), one = splat(1.0), two = splat(2.0), four = splat(4.0);
-  const V inv_h = splat(c.inv_h), sw = splat(c.sigma_w * 0.25), sdw = splat(c.sigma_dw * 0.75);
+  const V inv_h = splat(c.kernel.inv_h), sw = splat(c.kernel.sigma_w * 0.25),
+          sdw = splat(c.kernel.sigma_dw * 0.75);  // SphKernel::w_dw
   const V inv_w0 = splat(c.inv_w0), eps2 = splat(c.eps2), tiny = splat(1e-18);
   const V cd = splat(c.collision_damping), fd = splat(c.friction_damping);
   std::size_t k = 0;
@@ -263,7 +257,8 @@ std::size_t active(const Vec3* x, const uint32_t* pair_i, const uint32_t* pair_j
                    uint32_t* act_i, uint32_t* act_j, uint32_t* act_slot) {
   const double* X = x->data();
   const V zero = splat(0.0), one = splat(1.0), two = splat(2.0), four = splat(4.0);
-  const V inv_h = splat(c.inv_h), sw = splat(c.sigma_w * 0.25), r2max = splat(c.r2max);
+  const V inv_h = splat(c.kernel.inv_h), sw = splat(c.kernel.sigma_w * 0.25),
+          r2max = splat(c.r2max);  // SphKernel::w
   std::size_t cnt = s0, s = s0;
   for (; s + 4 <= s1; s += 4) {
     const __m128i ii = _mm_loadu_si128(reinterpret_cast<const __m128i*>(pair_i + s));

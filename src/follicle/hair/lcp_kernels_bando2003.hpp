@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "follicle/core/types.hpp"
+#include "follicle/hair/sph_kernel.hpp"
 
 namespace follicle::hair::detail {
 
@@ -26,12 +27,12 @@ struct HairPairInputs {
 
 /// Constants of the pair force.
 struct HairPairConsts {
-  double inv_h = 0, sigma_w = 0, sigma_dw = 0;  // Monaghan's kernel (SphKernel) for h
-  double inv_w0 = 0;                            // 1 / W(h, 0)
-  double r2max = 0;                             // (2h)^2
-  double eps2 = 0;                              // colinear_eps^2
-  double collision_damping = 0;                 // d_c of (3.17) per reduced mass [1/s]
-  double friction_damping = 0;                  // d_f of (3.18) per reduced mass [1/s]
+  SphKernel kernel{1.0};         // Monaghan's kernel for h
+  double inv_w0 = 0;             // 1 / W(h, 0)
+  double r2max = 0;              // (2h)^2
+  double eps2 = 0;               // colinear_eps^2
+  double collision_damping = 0;  // d_c of (3.17) per reduced mass [1/s]
+  double friction_damping = 0;   // d_f of (3.18) per reduced mass [1/s]
 };
 
 /// Force on particle i from particle j (0 < |x_j - x_i| < 2h), the reference for the batch

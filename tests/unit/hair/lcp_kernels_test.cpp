@@ -61,9 +61,7 @@ PairSet random_pairs(std::size_t n, std::size_t npairs, double h, unsigned seed)
 detail::HairPairConsts consts_for(double h) {
   const SphKernel K(h);
   detail::HairPairConsts c;
-  c.inv_h = K.inv_h;
-  c.sigma_w = K.sigma_w;
-  c.sigma_dw = K.sigma_dw;
+  c.kernel = K;
   c.inv_w0 = 1.0 / K.w(0.0);
   c.r2max = 4 * h * h;
   c.eps2 = 0.2 * 0.2;
