@@ -794,8 +794,8 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
   ws.geom_owner = nullptr;  // the geometry below is not step()'s cache
   const detail::SpringInputs sin = spring_inputs(s, ws, false);
   parallel_chunks(ctx, np, kChunk, [&](std::size_t q0, std::size_t q1) {
-    for (std::size_t q = q0; q < q1; ++q) geometry_of(q, s, ws);
-    detail::lcp_springs(sin, q0, q1, ws.spring_f.data());
+    geometry_of(q0, q1, s, ws);
+    m_kernels.springs(sin, q0, q1, ws.spring_f.data());
   });
   const bool hh = p.hair_hair && ws.nbr_offsets.size() == n + 1 && ws.density.size() == n &&
                   ws.pressure.size() == n && ws.nbr_mirror.size() == ws.nbrs.size() &&
@@ -822,18 +822,10 @@ void LcpSolver::pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWor
   });
 }
 
-namespace {
-// |x_ab| and x^_ab of connection q (x_ab = x_b - x_a): shared by k_ij (3.7), the spring forces
-// and the direction update (3.15) of both ends (x_ji = -x_ij exactly).
-inline void connection_geometry(const Vec3& xa, const Vec3& xb, double& r, Vec3& xh) {
-  const Vec3 d = xb - xa;  // x_ab
-  r = d.norm();
-  xh = d * (1.0 / r);
-}
-}  // namespace
-
-void LcpSolver::geometry_of(std::size_t q, const LcpState& s, LcpWorkspace& ws) const {
-  connection_geometry(s.x[m_model.pair_a[q]], s.x[m_model.pair_b[q]], ws.conn_r[q], ws.conn_xh[q]);
+void LcpSolver::geometry_of(std::size_t q0, std::size_t q1, const LcpState& s,
+                            LcpWorkspace& ws) const {
+  m_kernels.geometry(s.x.data(), m_model.pair_a.data(), m_model.pair_b.data(), q0, q1,
+                     ws.conn_r.data(), ws.conn_xh.data());
 }
 
 detail::DirectionInputs LcpSolver::direction_inputs(const double* conn_r, const Vec3* conn_xh,
@@ -861,8 +853,8 @@ void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWork
   const std::size_t np = m.num_pairs();
   std::vector<double> r(np);
   std::vector<Vec3> xh(np);
-  parallel_for(ctx, 0, np, [&](std::size_t q) {
-    connection_geometry(s.x[m.pair_a[q]], s.x[m.pair_b[q]], r[q], xh[q]);
+  parallel_chunks(ctx, np, kChunk, [&](std::size_t q0, std::size_t q1) {
+    m_kernels.geometry(s.x.data(), m.pair_a.data(), m.pair_b.data(), q0, q1, r.data(), xh.data());
   });
   const detail::DirectionInputs din = direction_inputs(r.data(), xh.data(), ws);
   parallel_chunks(ctx, m.size(), kChunk, [&](std::size_t i0, std::size_t i1) {
@@ -907,7 +899,9 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.conn_r.resize(np);
   ws.conn_xh.resize(np);
   ws.geom_owner = nullptr;  // set again below once it matches s.x
-  if (!geom_valid) parallel_for(ctx, 0, np, [&](std::size_t q) { geometry_of(q, s, ws); });
+  if (!geom_valid)
+    parallel_chunks(ctx, np, kChunk,
+                    [&](std::size_t q0, std::size_t q1) { geometry_of(q0, q1, s, ws); });
   // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
   // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
   int nsub = P.substeps;
@@ -1016,7 +1010,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
         ctx, 0, nconn + (hh ? nchunks : 0),
         [&](std::size_t c) {
           if (c >= nconn) return hair_pairs_of(c - nconn, s, ws, pc);
-          detail::lcp_springs(sin, c * kChunk, std::min(np, (c + 1) * kChunk), ws.spring_f.data());
+          m_kernels.springs(sin, c * kChunk, std::min(np, (c + 1) * kChunk), ws.spring_f.data());
         },
         1);
     // 4. Gather, accelerations and the leapfrog update (each particle reads only its own state
@@ -1062,8 +1056,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     });
     // 5. Connection geometry at the new positions, then directions (3.15) and the blow-up
     // check: first non-finite or too fast particle, in index order.
-    parallel_for(
-        ctx, 0, np, [&](std::size_t q) { geometry_of(q, s, ws); }, kChunk);
+    parallel_chunks(ctx, np, kChunk,
+                    [&](std::size_t q0, std::size_t q1) { geometry_of(q0, q1, s, ws); });
     const double vlim = P.max_speed;
     const detail::DirectionInputs din = direction_inputs(ws.conn_r.data(), ws.conn_xh.data(), ws);
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {

@@ -264,9 +264,9 @@ class LcpSolver {
   /// A_i of (3.9).
   double cross_section(std::size_t i) const;
 
-  /// Selects the hair-hair pair kernels: the AVX2 batch kernels when the CPU has them (default)
-  /// or the scalar loops. Both give the same bits (ADR 0008); the switch is for tests and A/B
-  /// benchmarks.
+  /// Selects the kernels of the hair-hair pairs, the springs and the connection geometry: the
+  /// AVX2 versions when the CPU has them (default) or the scalar loops. Both give the same bits
+  /// (ADR 0008); the switch is for tests and A/B benchmarks.
   void use_simd(bool on) { m_kernels = detail::lcp_kernels(on); }
 
   const LcpModel& model() const { return m_model; }
@@ -290,7 +290,8 @@ class LcpSolver {
   void hair_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
                      const detail::HairPairConsts& pc) const;
   detail::GatherInputs gather_inputs(const LcpWorkspace& ws, bool hh) const;
-  void geometry_of(std::size_t q, const LcpState& s, LcpWorkspace& ws) const;
+  // |x_ab| and x^_ab of connections q0 .. q1 - 1 into ws.conn_r / ws.conn_xh.
+  void geometry_of(std::size_t q0, std::size_t q1, const LcpState& s, LcpWorkspace& ws) const;
   detail::DirectionInputs direction_inputs(const double* conn_r, const Vec3* conn_xh,
                                            const LcpWorkspace& ws) const;
   void density_of(std::size_t i, LcpWorkspace& ws, double w0) const;

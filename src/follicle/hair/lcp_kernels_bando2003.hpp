@@ -6,8 +6,9 @@
 // instruction, double precision) when the CPU has it. The AVX2 versions perform the same IEEE
 // operations in the same order as the scalar code, lane by lane (no FMA, no reduction across
 // lanes), so both give the same bits; the solver's results do not depend on which runs
-// (ADR 0008). The springs, the force gather and the direction update (3.15) are scalar: AVX2
-// versions with one particle or connection per lane were measured and gave nothing (ADR 0008).
+// (ADR 0008). The connection geometry and the springs (one connection per lane) have AVX2
+// versions too; the force gather and the direction update (3.15) are scalar: AVX2 versions with
+// one particle per lane were measured and gave nothing (ADR 0008).
 #include <cstddef>
 #include <cstdint>
 
@@ -105,9 +106,22 @@ Vec3 spring_force(const SpringInputs& in, std::size_t q);
 /// alpha_ij (3.14) when requested and spring_f[q] = spring_force(q) for q0 <= q < q1.
 void lcp_springs(const SpringInputs& in, std::size_t q0, std::size_t q1, Vec3* spring_f);
 
+using SpringsFn = void (*)(const SpringInputs& in, std::size_t q0, std::size_t q1, Vec3* spring_f);
+
+/// Connection geometry for q0 <= q < q1: x_ab = x[pair_b[q]] - x[pair_a[q]], r[q] = |x_ab| and
+/// xh[q] = x_ab (1 / r[q]). Shared by k_ij (3.7), the springs and the direction update (3.15)
+/// of both ends.
+void lcp_geometry(const Vec3* x, const uint32_t* pair_a, const uint32_t* pair_b, std::size_t q0,
+                  std::size_t q1, double* r, Vec3* xh);
+
+using GeometryFn = void (*)(const Vec3* x, const uint32_t* pair_a, const uint32_t* pair_b,
+                            std::size_t q0, std::size_t q1, double* r, Vec3* xh);
+
 struct LcpKernels {
   ActivePairsFn active = nullptr;
   HairPairBatchFn forces = nullptr;
+  SpringsFn springs = nullptr;
+  GeometryFn geometry = nullptr;
   bool simd = false;  // the AVX2 kernels
 };
 

@@ -1,5 +1,6 @@
-// The hair-hair pair kernel (3.16)-(3.18): the AVX2 batch kernel against the scalar reference
-// (same bits), and the solver with either kernel (same trajectories).
+// The sub-step kernels: the hair-hair pair kernel (3.16)-(3.18), the springs and the connection
+// geometry, each AVX2 version against its scalar reference (same bits), and the solver with
+// either set (same trajectories).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -415,5 +416,61 @@ TEST(LcpKernels, SpringsStretchCompressAndDamp) {
     }
     EXPECT_TRUE(fa[7] == Vec3::Zero());
     EXPECT_GT(compressed, 40);
+    // The AVX2 springs (four connections per step, scalar tail) give the same bits, for every
+    // start and end of the range modulo the vector width.
+    const auto kern = detail::lcp_kernels(true);
+    if (!kern.simd) continue;
+    for (std::size_t q0 : {0, 1, 2, 3})
+      for (std::size_t q1 : {np, np - 1, np - 2, np - 3}) {
+        std::vector<double> alpha_s(np, 1.25), alpha_r(np, 1.25);
+        std::vector<Vec3> fs(np, Vec3::Constant(5)), fr(np, Vec3::Constant(5));
+        in.alpha = alpha_s.data();
+        kern.springs(in, q0, q1, fs.data());
+        in.alpha = alpha_r.data();
+        detail::lcp_springs(in, q0, q1, fr.data());
+        for (std::size_t q = 0; q < np; ++q) {
+          ASSERT_TRUE(same_bits(fs[q], fr[q])) << q0 << ".." << q1 << " connection " << q;
+          ASSERT_EQ(std::memcmp(&alpha_s[q], &alpha_r[q], sizeof(double)), 0) << q;
+        }
+      }
   }
+}
+
+TEST(LcpKernels, ConnectionGeometryIsTheUnitVectorAndLength) {
+  // r = |x_b - x_a| and x^ = x_ab / r for every connection of the range (nothing outside it);
+  // the AVX2 version gives the same bits for every range start and end modulo the vector width.
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::size_t n = 50, np = 131;
+  std::vector<Vec3> x(n);
+  for (auto& p : x) p = Vec3(u(rng), u(rng), u(rng)) * 0.02;
+  std::vector<uint32_t> pa(np), pb(np);
+  for (std::size_t q = 0; q < np; ++q) {
+    pa[q] = uint32_t(rng() % n);
+    pb[q] = uint32_t((pa[q] + 1 + rng() % (n - 1)) % n);
+  }
+  const auto kern = detail::lcp_kernels(true);
+  for (std::size_t q0 : {0, 1, 2, 3})
+    for (std::size_t q1 : {np, np - 1, np - 2, np - 3}) {
+      std::vector<double> r(np, -1.0), rs(np, -1.0);
+      std::vector<Vec3> xh(np, Vec3::Constant(9)), xs(np, Vec3::Constant(9));
+      detail::lcp_geometry(x.data(), pa.data(), pb.data(), q0, q1, r.data(), xh.data());
+      for (std::size_t q = 0; q < np; ++q) {
+        if (q < q0 || q >= q1) {
+          EXPECT_EQ(r[q], -1.0);
+          EXPECT_TRUE(xh[q] == Vec3::Constant(9));
+          continue;
+        }
+        const Vec3 d = x[pb[q]] - x[pa[q]];
+        EXPECT_NEAR(r[q], d.norm(), 1e-16);
+        EXPECT_NEAR(xh[q].norm(), 1.0, 1e-14);
+        EXPECT_LT((xh[q] * r[q] - d).norm(), 1e-16);
+      }
+      if (!kern.simd) continue;
+      kern.geometry(x.data(), pa.data(), pb.data(), q0, q1, rs.data(), xs.data());
+      for (std::size_t q = 0; q < np; ++q) {
+        ASSERT_EQ(std::memcmp(&r[q], &rs[q], sizeof(double)), 0) << q0 << ".." << q1 << " " << q;
+        ASSERT_TRUE(same_bits(xh[q], xs[q])) << q0 << ".." << q1 << " " << q;
+      }
+    }
 }
