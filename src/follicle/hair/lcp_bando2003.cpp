@@ -429,8 +429,9 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
 //   3. (connections, then particles) alpha_ij (3.14) and the spring force per connection;
 //      hair-hair forces (3.16)-(3.18) per particle
 //   4. (particles) gather of the forces, accelerations and the leapfrog update
-//   5. (connections) geometry |x_ab|, x^_ab at the new positions
-//   6. (particles) direction update (3.15) from that geometry and the blow-up check
+//   5. (connections) geometry |x_ab|, x^_ab at the new positions and the (3.15) terms of both
+//      ends
+//   6. (particles) direction update (3.15): the sum of those terms, and the blow-up check
 // Each particle's connections are kept in two lists by its role (root-side / tip-side end), so
 // none of the particle loops branches per connection on which end it is.
 
@@ -466,28 +467,32 @@ LcpSolver::LcpSolver(const LcpParams& params, LcpModel model, const sim::VoxelPl
   for (std::size_t i = 0; i < n; ++i) m_ea[i] = m_params.elastic_modulus * cross_section(i);
   // Connections of each particle by its role (pair_b == i: root-side partner; pair_a == i:
   // tip-side partner), in adjacency order.
-  auto split = [&](bool as_b, std::vector<uint32_t>& off, std::vector<uint32_t>& pairs,
-                   std::vector<double>& cs, std::vector<double>& sn) {
+  auto split = [&](bool as_b, std::vector<uint32_t>& off, std::vector<uint32_t>& pairs) {
     off.assign(n + 1, 0);
     pairs.clear();
-    cs.clear();
-    sn.clear();
     for (std::size_t i = 0; i < n; ++i) {
       for (uint32_t e = m_model.adj_offsets[i]; e < m_model.adj_offsets[i + 1]; ++e) {
         const uint32_t q = m_model.adj_pairs[e];
-        if ((as_b ? m_model.pair_b[q] : m_model.pair_a[q]) != i) continue;
-        pairs.push_back(q);
-        // cos theta0_ij against x_ij = x_j - x_i: +cos_a at the root-side end, -cos_b at the
-        // tip-side end (x_ij = -x_ab there).
-        const double c0 = as_b ? m_model.cos_b[q] : m_model.cos_a[q];
-        cs.push_back(as_b ? -c0 : c0);
-        sn.push_back(std::sqrt(std::max(0.0, 1 - c0 * c0)));  // sin theta0 of this end
+        if ((as_b ? m_model.pair_b[q] : m_model.pair_a[q]) == i) pairs.push_back(q);
       }
       off[i + 1] = uint32_t(pairs.size());
     }
   };
-  split(true, m_rs_offsets, m_rs_pairs, m_rs_cos, m_rs_sin);
-  split(false, m_ts_offsets, m_ts_pairs, m_ts_cos, m_ts_sin);
+  split(true, m_rs_offsets, m_rs_pairs);
+  split(false, m_ts_offsets, m_ts_pairs);
+  // cos theta0_ij against x_ij = x_j - x_i per end: +cos_a at the root-side end, -cos_b at the
+  // tip-side end (x_ij = -x_ab there); sin theta0 of each end.
+  m_cos_a.resize(np);
+  m_sin_a.resize(np);
+  m_cos_b.resize(np);
+  m_sin_b.resize(np);
+  for (std::size_t q = 0; q < np; ++q) {
+    const double ca = m_model.cos_a[q], cb = m_model.cos_b[q];
+    m_cos_a[q] = ca;
+    m_sin_a[q] = std::sqrt(std::max(0.0, 1 - ca * ca));
+    m_cos_b[q] = -cb;
+    m_sin_b[q] = std::sqrt(std::max(0.0, 1 - cb * cb));
+  }
   m_damp.resize(np);
   for (std::size_t q = 0; q < np; ++q) {
     const double ma = m_model.mass[m_model.pair_a[q]], mb = m_model.mass[m_model.pair_b[q]];
@@ -828,37 +833,46 @@ void LcpSolver::geometry_of(std::size_t q0, std::size_t q1, const LcpState& s,
                      ws.conn_r.data(), ws.conn_xh.data());
 }
 
-detail::DirectionInputs LcpSolver::direction_inputs(const double* conn_r, const Vec3* conn_xh,
-                                                    const LcpWorkspace& ws) const {
-  detail::DirectionInputs d;
-  d.ts_off = m_ts_offsets.data();
-  d.ts_pairs = m_ts_pairs.data();
-  d.ts_cos = m_ts_cos.data();
-  d.ts_sin = m_ts_sin.data();
-  d.rs_off = m_rs_offsets.data();
-  d.rs_pairs = m_rs_pairs.data();
-  d.rs_cos = m_rs_cos.data();
-  d.rs_sin = m_rs_sin.data();
-  d.conn_r = conn_r;
-  d.conn_xh = conn_xh;
+detail::DirectionTermInputs LcpSolver::direction_term_inputs(const LcpState& s,
+                                                             const LcpWorkspace& ws) const {
+  detail::DirectionTermInputs d;
+  d.x = s.x.data();
+  d.t = s.t.data();
+  d.pair_a = m_model.pair_a.data();
+  d.pair_b = m_model.pair_b.data();
   d.alpha = ws.alpha.data();
   d.k = ws.k.data();
+  d.cos_a = m_cos_a.data();
+  d.sin_a = m_sin_a.data();
+  d.cos_b = m_cos_b.data();
+  d.sin_b = m_sin_b.data();
+  return d;
+}
+
+detail::DirectionSumInputs LcpSolver::direction_sum_inputs(const double* term) const {
+  detail::DirectionSumInputs d;
+  d.ts_off = m_ts_offsets.data();
+  d.ts_pairs = m_ts_pairs.data();
+  d.rs_off = m_rs_offsets.data();
+  d.rs_pairs = m_rs_pairs.data();
+  d.term = term;
   d.root = m_model.root.data();
   return d;
 }
 
 void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWorkspace& ws) const {
-  // (3.15) from the current positions (the geometry computed here as in step()).
+  // (3.15) from the current positions (the geometry and terms computed here as in step()).
   const auto& m = m_model;
   const std::size_t np = m.num_pairs();
-  std::vector<double> r(np);
+  std::vector<double> r(np), term(8 * np);
   std::vector<Vec3> xh(np);
+  const detail::DirectionTermInputs tin = direction_term_inputs(s, ws);
   parallel_chunks(ctx, np, kChunk, [&](std::size_t q0, std::size_t q1) {
-    m_kernels.geometry(s.x.data(), m.pair_a.data(), m.pair_b.data(), q0, q1, r.data(), xh.data());
+    m_kernels.geometry_terms(tin, q0, q1, r.data(), xh.data(), term.data());
   });
-  const detail::DirectionInputs din = direction_inputs(r.data(), xh.data(), ws);
+  const detail::DirectionSumInputs din = direction_sum_inputs(term.data());
   parallel_chunks(ctx, m.size(), kChunk, [&](std::size_t i0, std::size_t i1) {
-    detail::lcp_directions(din, i0, i1, s.t.data());
+    detail::lcp_direction_sum(din, i0, i1, s.t.data());
   });
 }
 
@@ -898,6 +912,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
                           std::memcmp(ws.geom_x.data(), s.x.data(), n * sizeof(Vec3)) == 0;
   ws.conn_r.resize(np);
   ws.conn_xh.resize(np);
+  ws.dir_term.resize(8 * np);
   ws.geom_owner = nullptr;  // set again below once it matches s.x
   if (!geom_valid)
     parallel_chunks(ctx, np, kChunk,
@@ -1054,14 +1069,18 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
         s.x[i] += s.v[i] * dt;
       }
     });
-    // 5. Connection geometry at the new positions, then directions (3.15) and the blow-up
-    // check: first non-finite or too fast particle, in index order.
-    parallel_chunks(ctx, np, kChunk,
-                    [&](std::size_t q0, std::size_t q1) { geometry_of(q0, q1, s, ws); });
+    // 5. Connection geometry at the new positions with the terms of (3.15) of both ends, then
+    // per particle the new direction (3.15) and the blow-up check: first non-finite or too fast
+    // particle, in index order.
+    const detail::DirectionTermInputs tin = direction_term_inputs(s, ws);
+    parallel_chunks(ctx, np, kChunk, [&](std::size_t q0, std::size_t q1) {
+      m_kernels.geometry_terms(tin, q0, q1, ws.conn_r.data(), ws.conn_xh.data(),
+                               ws.dir_term.data());
+    });
     const double vlim = P.max_speed;
-    const detail::DirectionInputs din = direction_inputs(ws.conn_r.data(), ws.conn_xh.data(), ws);
+    const detail::DirectionSumInputs din = direction_sum_inputs(ws.dir_term.data());
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
-      detail::lcp_directions(din, i0, i1, s.t.data());  // (3.15)
+      detail::lcp_direction_sum(din, i0, i1, s.t.data());  // (3.15)
       LcpWorkspace::ChunkCheck c;
       for (std::size_t i = i0; i < i1; ++i) {
         const double sp = s.v[i].norm();

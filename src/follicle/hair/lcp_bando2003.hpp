@@ -201,6 +201,9 @@ struct LcpWorkspace {
   std::vector<double> conn_r;
   std::vector<Vec3> conn_xh;
   std::vector<Vec3> geom_x;
+  // The terms of the direction update (3.15) of both ends of each connection, 8 per connection
+  // (detail::lcp_geometry_terms), computed with the geometry.
+  std::vector<double> dir_term;
   const void* geom_owner = nullptr;  // the solver that computed conn_r / conn_xh
   std::vector<double> chunk_max;     // per-chunk reduction scratch
   struct ChunkCheck {
@@ -292,15 +295,18 @@ class LcpSolver {
   detail::GatherInputs gather_inputs(const LcpWorkspace& ws, bool hh) const;
   // |x_ab| and x^_ab of connections q0 .. q1 - 1 into ws.conn_r / ws.conn_xh.
   void geometry_of(std::size_t q0, std::size_t q1, const LcpState& s, LcpWorkspace& ws) const;
-  detail::DirectionInputs direction_inputs(const double* conn_r, const Vec3* conn_xh,
-                                           const LcpWorkspace& ws) const;
+  detail::DirectionTermInputs direction_term_inputs(const LcpState& s,
+                                                    const LcpWorkspace& ws) const;
+  detail::DirectionSumInputs direction_sum_inputs(const double* term) const;
   void density_of(std::size_t i, LcpWorkspace& ws, double w0) const;
   // Each particle's connections split by its role, in adjacency order, so the per-particle loops
   // run without a data-dependent branch per connection: m_rs_* lists the connections of which
   // the particle is the tip-side end b (its partner is in N_r), m_ts_* those of which it is the
-  // root-side end a (partner in N_t). Per entry, cos/sin theta0 of the particle's own end.
+  // root-side end a (partner in N_t).
   std::vector<uint32_t> m_rs_offsets, m_rs_pairs, m_ts_offsets, m_ts_pairs;
-  std::vector<double> m_rs_cos, m_rs_sin, m_ts_cos, m_ts_sin;
+  // Per connection, cos theta0 against x_ij seen from each end (x_ij = x_ab at a, -x_ab at b)
+  // and sin theta0 of each end (the direction update (3.15)).
+  std::vector<double> m_cos_a, m_sin_a, m_cos_b, m_sin_b;
   std::vector<double> m_damp;  // 2 zeta sqrt(mu_ab) per connection (spring damping factor)
   LcpParams m_params;
   std::vector<double> m_ea;  // E A_i per particle ((3.9) with the constant modulus)

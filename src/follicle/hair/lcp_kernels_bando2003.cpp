@@ -101,34 +101,56 @@ void batch_scalar(const HairPairInputs& in, const HairPairConsts& c, const uint3
 
 }  // namespace
 
-void lcp_directions(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t) {
+namespace {
+// The (3.15) term of one connection end: (A x^_ij, B) into out[0..3] (lcp_geometry_terms).
+inline void direction_term(const Vec3& ti, const Vec3& xh, double ak, double c0, double s0,
+                           double* out) {
+  const double d = ti.dot(xh);
+  const double pn = (ti - d * xh).norm();
+  const double sp = pn > 1e-12 ? ak * s0 / pn : 0.0;
+  const Vec3 a = (ak * c0 - sp * d) * xh;
+  out[0] = a.x();
+  out[1] = a.y();
+  out[2] = a.z();
+  out[3] = sp;
+}
+}  // namespace
+
+void lcp_geometry_terms(const DirectionTermInputs& in, std::size_t q0, std::size_t q1, double* r,
+                        Vec3* xh, double* term) {
+  lcp_geometry(in.x, in.pair_a, in.pair_b, q0, q1, r, xh);
+  for (std::size_t q = q0; q < q1; ++q) {
+    double* o = term + 8 * q;
+    if (!(r[q] > 0)) {
+      std::fill(o, o + 8, 0.0);
+      continue;
+    }
+    const double ak = in.alpha[q] * in.k[q];
+    direction_term(in.t[in.pair_a[q]], xh[q], ak, in.cos_a[q], in.sin_a[q], o);
+    direction_term(in.t[in.pair_b[q]], -1.0 * xh[q], ak, in.cos_b[q], in.sin_b[q], o + 4);
+  }
+}
+
+void lcp_direction_sum(const DirectionSumInputs& in, std::size_t i0, std::size_t i1, Vec3* t) {
+  // t_i^j = cos0 x^ + sin0 (t_i - (t_i . x^) x^) / |t_i - (t_i . x^) x^|, so
+  // sum_j ak t_i^j = sum_j [A_j x^_j] + (sum_j B_j) t_i with the terms of lcp_geometry_terms.
+  // A skipped end (|x_ab| not > 0) has zero terms; adding +0 to the sums (which start at +0 and
+  // so never hold -0) changes no bit.
   for (std::size_t i = i0; i < i1; ++i) {
     if (in.root[i]) continue;
     const Vec3 ti = t[i];
-    // (3.15) t_i = sum_j alpha_ij k_ij t_i^j / |.|, with t_i^j the unit vector at angle theta0_ij
-    // from x^_ij in the plane of t_i and x_ij (Fig. 3.3 c):
-    //   t_i^j = cos0 x^ + sin0 (t_i - (t_i . x^) x^) / |t_i - (t_i . x^) x^|.
-    // Summed as acc = sum_j [a_j x^_j] + b t_i with scalar a_j = ak (cos0 - sin0 (t_i . x^) / p_j)
-    // and b = sum_j ak sin0 / p_j (p_j = |t_i - (t_i . x^) x^|; the sin0 part drops when p_j
-    // vanishes, x^ parallel to t_i). sign = +1 where i is the root-side end a (x_ij = x_ab),
-    // -1 where it is the tip-side end b.
     Vec3 acc = Vec3::Zero();
     double bsum = 0;
-    auto add = [&](uint32_t q, double sign, double c0, double s0) {
-      const double r = in.conn_r[q];
-      const Vec3 xh = sign * in.conn_xh[q];  // x^_ij
-      if (!(r > 0)) return;
-      const double ak = in.alpha[q] * in.k[q];
-      const double d = ti.dot(xh);
-      const double pn = (ti - d * xh).norm();
-      const double sp = pn > 1e-12 ? ak * s0 / pn : 0.0;
-      acc += (ak * c0 - sp * d) * xh;
-      bsum += sp;
-    };
-    for (uint32_t e = in.ts_off[i]; e < in.ts_off[i + 1]; ++e)
-      add(in.ts_pairs[e], 1.0, in.ts_cos[e], in.ts_sin[e]);
-    for (uint32_t e = in.rs_off[i]; e < in.rs_off[i + 1]; ++e)
-      add(in.rs_pairs[e], -1.0, in.rs_cos[e], in.rs_sin[e]);
+    for (uint32_t e = in.ts_off[i]; e < in.ts_off[i + 1]; ++e) {
+      const double* o = in.term + 8 * std::size_t(in.ts_pairs[e]);
+      acc += Vec3(o[0], o[1], o[2]);
+      bsum += o[3];
+    }
+    for (uint32_t e = in.rs_off[i]; e < in.rs_off[i + 1]; ++e) {
+      const double* o = in.term + 8 * std::size_t(in.rs_pairs[e]) + 4;
+      acc += Vec3(o[0], o[1], o[2]);
+      bsum += o[3];
+    }
     acc += bsum * ti;
     const double an = acc.norm();
     if (an > 1e-300 && std::isfinite(an)) t[i] = acc / an;
@@ -350,6 +372,63 @@ void geometry(const Vec3* x, const uint32_t* pair_a, const uint32_t* pair_b, std
   lcp_geometry(x, pair_a, pair_b, q, q1, r, xh);
 }
 
+inline void transpose4(V& a, V& b, V& c, V& d) {
+  const __m256d t0 = _mm256_unpacklo_pd(__m256d(a), __m256d(b));
+  const __m256d t1 = _mm256_unpackhi_pd(__m256d(a), __m256d(b));
+  const __m256d t2 = _mm256_unpacklo_pd(__m256d(c), __m256d(d));
+  const __m256d t3 = _mm256_unpackhi_pd(__m256d(c), __m256d(d));
+  a = V(_mm256_permute2f128_pd(t0, t2, 0x20));
+  b = V(_mm256_permute2f128_pd(t1, t3, 0x20));
+  c = V(_mm256_permute2f128_pd(t0, t2, 0x31));
+  d = V(_mm256_permute2f128_pd(t1, t3, 0x31));
+}
+
+// direction_term for four connection ends: (A x^, B) per lane, zero where `ok` is false.
+inline void direction_terms(const V3& ti, V hx, V hy, V hz, V ak, V c0, V s0, V ok_mask, V out[4]) {
+  const V zero = splat(0.0), tiny = splat(1e-12);
+  const V d = ti.x * hx + ti.y * hy + ti.z * hz;
+  const V px = ti.x - d * hx, py = ti.y - d * hy, pz = ti.z - d * hz;
+  const V pn = vsqrt(px * px + py * py + pz * pz);
+  const V sp = pn > tiny ? ak * s0 / pn : zero;
+  const V a = ak * c0 - sp * d;
+  const auto ok = ok_mask != zero;
+  out[0] = ok ? a * hx : zero;
+  out[1] = ok ? a * hy : zero;
+  out[2] = ok ? a * hz : zero;
+  out[3] = ok ? sp : zero;
+}
+
+// lcp_geometry_terms with four connections per step.
+void geometry_terms(const DirectionTermInputs& in, std::size_t q0, std::size_t q1, double* r,
+                    Vec3* xh, double* term) {
+  const V zero = splat(0.0), one = splat(1.0), minus = splat(-1.0);
+  std::size_t q = q0;
+  for (; q + 4 <= q1; q += 4) {
+    const V3 a = load3(in.x, in.pair_a + q), b = load3(in.x, in.pair_b + q);
+    const V dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+    const V rr = vsqrt(dx * dx + dy * dy + dz * dz);
+    const V inv = one / rr;
+    const V hx = dx * inv, hy = dy * inv, hz = dz * inv;
+    std::memcpy(r + q, &rr, sizeof(rr));
+    store3(xh + q, {hx, hy, hz});
+    const V ok = rr > zero ? one : zero;
+    const V ak = loadu(in.alpha + q) * loadu(in.k + q);
+    V ta[4], tb[4];
+    direction_terms(load3(in.t, in.pair_a + q), hx, hy, hz, ak, loadu(in.cos_a + q),
+                    loadu(in.sin_a + q), ok, ta);
+    direction_terms(load3(in.t, in.pair_b + q), minus * hx, minus * hy, minus * hz, ak,
+                    loadu(in.cos_b + q), loadu(in.sin_b + q), ok, tb);
+    transpose4(ta[0], ta[1], ta[2], ta[3]);  // lane l of component c -> connection l's row
+    transpose4(tb[0], tb[1], tb[2], tb[3]);
+    double* o = term + 8 * q;
+    for (int l = 0; l < 4; ++l) {
+      _mm256_storeu_pd(o + 8 * l, __m256d(ta[l]));
+      _mm256_storeu_pd(o + 8 * l + 4, __m256d(tb[l]));
+    }
+  }
+  lcp_geometry_terms(in, q, q1, r, xh, term);
+}
+
 }  // namespace avx2
 #pragma GCC pop_options
 #endif
@@ -357,10 +436,11 @@ void geometry(const Vec3* x, const uint32_t* pair_a, const uint32_t* pair_b, std
 LcpKernels lcp_kernels(bool allow_simd) {
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
   if (allow_simd && __builtin_cpu_supports("avx2"))
-    return {&avx2::active, &avx2::batch, &avx2::springs, &avx2::geometry, true};
+    return {&avx2::active,   &avx2::batch,          &avx2::springs,
+            &avx2::geometry, &avx2::geometry_terms, true};
 #endif
   (void)allow_simd;
-  return {&active_scalar, &batch_scalar, &lcp_springs, &lcp_geometry, false};
+  return {&active_scalar, &batch_scalar, &lcp_springs, &lcp_geometry, &lcp_geometry_terms, false};
 }
 
 }  // namespace follicle::hair::detail

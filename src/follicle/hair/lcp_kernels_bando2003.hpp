@@ -6,9 +6,9 @@
 // instruction, double precision) when the CPU has it. The AVX2 versions perform the same IEEE
 // operations in the same order as the scalar code, lane by lane (no FMA, no reduction across
 // lanes), so both give the same bits; the solver's results do not depend on which runs
-// (ADR 0008). The connection geometry and the springs (one connection per lane) have AVX2
-// versions too; the force gather and the direction update (3.15) are scalar: AVX2 versions with
-// one particle per lane were measured and gave nothing (ADR 0008).
+// (ADR 0008). The connection geometry with the terms of the direction update (3.15) and the
+// springs (one connection per lane) have AVX2 versions too; the per-particle sums (force gather,
+// (3.15)) are scalar: AVX2 versions with one particle per lane measured nothing (ADR 0008).
 #include <cstddef>
 #include <cstdint>
 
@@ -54,22 +54,44 @@ using ActivePairsFn = std::size_t (*)(const Vec3* x, const uint32_t* pair_i, con
                                       double* w, uint32_t* act_i, uint32_t* act_j,
                                       uint32_t* act_slot);
 
-/// Inputs of the direction update (3.15) from the cached connection geometry: each particle's
-/// connections by role (CSR; ts = it is the root-side end, rs = the tip-side end) with cos/sin
-/// theta0 of its own end, and per connection |x_ab|, x^_ab, alpha_ij and k_ij.
-struct DirectionInputs {
-  const uint32_t *ts_off = nullptr, *ts_pairs = nullptr, *rs_off = nullptr, *rs_pairs = nullptr;
-  const double *ts_cos = nullptr, *ts_sin = nullptr, *rs_cos = nullptr, *rs_sin = nullptr;
-  const double* conn_r = nullptr;
-  const Vec3* conn_xh = nullptr;
+/// Per-connection inputs of the direction update (3.15): positions and the current directions
+/// by particle; per connection a -> b its ends, alpha_ij, k_ij and cos/sin theta0 at each end,
+/// cos against x_ij seen from that end (x_ij = x_ab at a, -x_ab at b).
+struct DirectionTermInputs {
+  const Vec3* x = nullptr;
+  const Vec3* t = nullptr;
+  const uint32_t *pair_a = nullptr, *pair_b = nullptr;
   const double *alpha = nullptr, *k = nullptr;
+  const double *cos_a = nullptr, *sin_a = nullptr, *cos_b = nullptr, *sin_b = nullptr;
+};
+
+/// lcp_geometry for q0 <= q < q1 and, from that geometry and the directions t, the two terms of
+/// (3.15) of each connection, 8 doubles per connection: term[8q .. 8q + 3] for end a and
+/// term[8q + 4 .. 8q + 7] for end b, each (A x^_ij, B) with A = ak (cos0 - sin0 (t_i . x^_ij) / p)
+/// and B = ak sin0 / p, ak = alpha_ij k_ij, p = |t_i - (t_i . x^_ij) x^_ij| (B = 0 when p
+/// vanishes); all zero when |x_ab| is not > 0. See lcp_direction_sum.
+void lcp_geometry_terms(const DirectionTermInputs& in, std::size_t q0, std::size_t q1, double* r,
+                        Vec3* xh, double* term);
+
+using GeometryTermsFn = void (*)(const DirectionTermInputs& in, std::size_t q0, std::size_t q1,
+                                 double* r, Vec3* xh, double* term);
+
+/// Inputs of the per-particle sum of (3.15): each particle's connections by role (CSR; ts = it
+/// is the root-side end a, rs = the tip-side end b), the terms of lcp_geometry_terms and the
+/// root flags.
+struct DirectionSumInputs {
+  const uint32_t *ts_off = nullptr, *ts_pairs = nullptr, *rs_off = nullptr, *rs_pairs = nullptr;
+  const double* term = nullptr;
   const uint8_t* root = nullptr;
 };
 
-/// (3.15) new direction t_i of every non-root particle i0 <= i < i1 (t is read and written).
-void lcp_directions(const DirectionInputs& in, std::size_t i0, std::size_t i1, Vec3* t);
+/// (3.15) new direction t_i of every non-root particle i0 <= i < i1: t_i = sum_j alpha_ij k_ij
+/// t_i^j / |.|, t_i^j the unit vector at angle theta0_ij from x^_ij in the plane of t_i and x_ij
+/// (Fig. 3.3 c), summed as sum_j A_j x^_j + (sum_j B_j) t_i over the ends' terms in a fixed
+/// order (root-side ends, then tip-side ends). t is read and written (its own entry only).
+void lcp_direction_sum(const DirectionSumInputs& in, std::size_t i0, std::size_t i1, Vec3* t);
 
-/// Inputs of the force gather: each particle's connections by role (as DirectionInputs) with
+/// Inputs of the force gather: each particle's connections by role (as DirectionSumInputs) with
 /// the spring force on the root-side end per connection, and with hair-hair interaction (hh)
 /// the sorted neighbour lists (nbr_off, nbr_upper: first entry above the particle's own index,
 /// nbr_pair: pair slot of each entry, pair_off: first pair slot of each particle) with the
@@ -122,6 +144,7 @@ struct LcpKernels {
   HairPairBatchFn forces = nullptr;
   SpringsFn springs = nullptr;
   GeometryFn geometry = nullptr;
+  GeometryTermsFn geometry_terms = nullptr;
   bool simd = false;  // the AVX2 kernels
 };
 

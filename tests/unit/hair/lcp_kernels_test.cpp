@@ -218,45 +218,155 @@ TEST(LcpKernels, SolverTrajectoriesDoNotDependOnTheKernel) {
       0.0);
 }
 
+namespace {
+
+// Runs (3.15) through lcp_geometry_terms (scalar or the given kernels) and lcp_direction_sum.
+void directions_by_kernel(const detail::GeometryTermsFn terms,
+                          const detail::DirectionTermInputs& tin, std::size_t np,
+                          const detail::DirectionSumInputs& sin_, std::size_t i0, std::size_t i1,
+                          Vec3* t) {
+  std::vector<double> r(np), term(8 * np, -3.0);
+  std::vector<Vec3> xh(np);
+  terms(tin, 0, np, r.data(), xh.data(), term.data());
+  detail::DirectionSumInputs in = sin_;
+  in.term = term.data();
+  detail::lcp_direction_sum(in, i0, i1, t);
+}
+
+}  // namespace
+
 TEST(LcpKernels, DirectionUpdateFollowsItsConnections) {
   // (3.15) with theta0 = 0 at every end (cos 1, sin 0): t_i^j = x^_ij, so a particle whose ends
-  // all point along one unit vector gets exactly that direction (sign -1 at the tip-side end);
-  // zero-length connections are skipped; root particles and particles without connections
+  // all point along one unit vector gets exactly that direction (x^_ij = -x^_ab at the tip-side
+  // end); zero-length connections are skipped; root particles and particles without connections
   // keep their direction; with theta0 = 90 degrees and t_i normal to x^ the direction stays.
   const Vec3 e = Vec3(1, 2, 2) / 3.0;
-  std::vector<double> r{0.01, 0.02, 0.0, 0.01}, alpha{1, 2, 1, 1},
-      k{3, 5, 5, 1};  // q1 outweighs q0: a wrong sign flips t
-  std::vector<Vec3> xh{e, -e, Vec3::UnitX(), Vec3::UnitZ()};
-  std::vector<uint8_t> root{0, 1, 0, 0, 0};
-  // Particle 0: root-side end of q0 (x^ = e) and tip-side end of q1 (x^_ij = -(-e) = e), plus
-  // the zero-length q2. Particle 1: a root. Particle 2: none. Particle 3: tip-side end of q3 at
-  // 90 degrees.
-  std::vector<uint32_t> ts_off{0, 2, 2, 2, 2, 2}, ts_pairs{0, 2}, rs_off{0, 1, 2, 2, 3, 3},
-      rs_pairs{1, 0, 3};
-  std::vector<double> ts_cos{1, 1}, ts_sin{0, 0}, rs_cos{1, 1, 0}, rs_sin{0, 0, 1};
-  detail::DirectionInputs in;
-  in.ts_off = ts_off.data();
-  in.ts_pairs = ts_pairs.data();
-  in.ts_cos = ts_cos.data();
-  in.ts_sin = ts_sin.data();
-  in.rs_off = rs_off.data();
-  in.rs_pairs = rs_pairs.data();
-  in.rs_cos = rs_cos.data();
-  in.rs_sin = rs_sin.data();
-  in.conn_r = r.data();
-  in.conn_xh = xh.data();
-  in.alpha = alpha.data();
-  in.k = k.data();
-  in.root = root.data();
-  const Vec3 t0 = Vec3(0, 0, 1), t3 = Vec3(1, 0, 0);
-  std::vector<Vec3> t{t0, Vec3::UnitY(), Vec3::UnitY(), t3, Vec3::UnitX()};
-  detail::lcp_directions(in, 0, 4, t.data());
-  EXPECT_LT((t[0] - e).norm(), 1e-15);
-  EXPECT_TRUE(t[1] == Vec3::UnitY());
-  EXPECT_TRUE(t[2] == Vec3::UnitY());
-  // q3 seen from its tip-side end: x^_ij = -z; theta0 = 90 degrees in the plane of t and x^.
-  EXPECT_LT((t[3] - t3).norm(), 1e-15);
-  EXPECT_TRUE(t[4] == Vec3::UnitX());  // outside the range
+  // Particles 0-4 are updated (0..3 in range); 5-8 are the far ends of the connections.
+  std::vector<Vec3> x(9, Vec3::Zero());
+  x[3] = Vec3(0.05, 0, 0);
+  x[5] = 0.01 * e;                 // q0: 0 -> 5, x^_ab = e
+  x[6] = 0.02 * e;                 // q1: 6 -> 0, x^_ab = -e, seen from 0: x^_ij = e
+  x[7] = x[0];                     // q2: 0 -> 7, zero length
+  x[8] = x[3] - Vec3(0, 0, 0.01);  // q3: 8 -> 3, x^_ab = z, seen from 3: -z
+  std::vector<uint32_t> pa{0, 6, 0, 8}, pb{5, 0, 7, 3};
+  std::vector<double> alpha{1, 2, 1, 1}, k{3, 5, 5, 1};  // q1 outweighs q0: a wrong sign flips t
+  std::vector<double> cos_a{1, 1, 1, 1}, sin_a{0, 0, 0, 0}, cos_b{1, 1, 1, 0}, sin_b{0, 0, 0, 1};
+  std::vector<uint8_t> root{0, 1, 0, 0, 0, 0, 0, 0, 0};
+  std::vector<uint32_t> ts_off{0, 2, 2, 2, 2, 2, 2, 2, 2, 2}, ts_pairs{0, 2},
+      rs_off{0, 1, 1, 1, 2, 2, 2, 2, 2, 2}, rs_pairs{1, 3};
+  std::vector<Vec3> t{Vec3(0, 0, 1), Vec3::UnitY(), Vec3::UnitY(), Vec3::UnitX(), Vec3::UnitX(),
+                      Vec3::UnitX(), Vec3::UnitX(), Vec3::UnitX(), Vec3::UnitX()};
+  detail::DirectionTermInputs tin;
+  tin.x = x.data();
+  tin.t = t.data();
+  tin.pair_a = pa.data();
+  tin.pair_b = pb.data();
+  tin.alpha = alpha.data();
+  tin.k = k.data();
+  tin.cos_a = cos_a.data();
+  tin.sin_a = sin_a.data();
+  tin.cos_b = cos_b.data();
+  tin.sin_b = sin_b.data();
+  detail::DirectionSumInputs din;
+  din.ts_off = ts_off.data();
+  din.ts_pairs = ts_pairs.data();
+  din.rs_off = rs_off.data();
+  din.rs_pairs = rs_pairs.data();
+  din.root = root.data();
+  for (int simd = 0; simd < 2; ++simd) {
+    const auto kern = detail::lcp_kernels(simd == 1);
+    std::vector<Vec3> tt = t;
+    tin.t = t.data();
+    directions_by_kernel(kern.geometry_terms, tin, pa.size(), din, 0, 4, tt.data());
+    EXPECT_LT((tt[0] - e).norm(), 1e-15) << tt[0].transpose();
+    EXPECT_TRUE(tt[1] == Vec3::UnitY());
+    EXPECT_TRUE(tt[2] == Vec3::UnitY());
+    // q3 seen from its tip-side end: x^_ij = -z; theta0 = 90 degrees in the plane of t and x^.
+    EXPECT_LT((tt[3] - Vec3::UnitX()).norm(), 1e-15);
+    EXPECT_TRUE(tt[4] == Vec3::UnitX());  // outside the range
+  }
+}
+
+TEST(LcpKernels, DirectionTermsGiveThePerEndSumBitForBit) {
+  // The connection-major form (terms per connection, then per particle the sum) against the
+  // direct per-end form of (3.15), for random connections with zero-length ones, theta0 of
+  // 0 and 90 degrees and directions along x^ (p = 0): the same bits, scalar and AVX2.
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::size_t n = 60, np = 187;
+  std::vector<Vec3> x(n), t(n);
+  std::vector<uint8_t> root(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = Vec3(u(rng), u(rng), u(rng)) * 0.02;
+    t[i] = Vec3(u(rng), u(rng), u(rng)).normalized();
+    root[i] = i % 11 == 3;
+  }
+  std::vector<uint32_t> pa(np), pb(np);
+  std::vector<double> alpha(np), k(np), cos_a(np), sin_a(np), cos_b(np), sin_b(np);
+  for (std::size_t q = 0; q < np; ++q) {
+    pa[q] = uint32_t(rng() % n);
+    pb[q] = uint32_t((pa[q] + 1 + rng() % (n - 1)) % n);
+    alpha[q] = 1 + 0.5 * u(rng);
+    k[q] = q % 17 == 4 ? 0.0 : 40 * (1.5 + u(rng));
+    const double ca = q % 9 == 0 ? 1.0 : u(rng), cb = q % 10 == 1 ? 0.0 : u(rng);
+    cos_a[q] = ca;
+    sin_a[q] = std::sqrt(std::max(0.0, 1 - ca * ca));
+    cos_b[q] = -cb;
+    sin_b[q] = std::sqrt(std::max(0.0, 1 - cb * cb));
+  }
+  x[pb[5]] = x[pa[5]];  // zero length
+  x[pb[8]] = x[pa[8]];
+  t[pa[12]] = (x[pb[12]] - x[pa[12]]).normalized();  // t along x^: p = 0 at that end
+  // CSR by role.
+  std::vector<uint32_t> ts_off(n + 1, 0), rs_off(n + 1, 0), ts_pairs, rs_pairs;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (uint32_t q = 0; q < np; ++q) {
+      if (pa[q] == i) ts_pairs.push_back(q);
+      if (pb[q] == i) rs_pairs.push_back(q);
+    }
+    ts_off[i + 1] = uint32_t(ts_pairs.size());
+    rs_off[i + 1] = uint32_t(rs_pairs.size());
+  }
+  // The per-end form: each particle sums its ends directly, skipping zero-length connections.
+  std::vector<Vec3> ref = t;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (root[i]) continue;
+    const Vec3 ti = t[i];
+    Vec3 acc = Vec3::Zero();
+    double bsum = 0;
+    auto add = [&](uint32_t q, double sign, double c0, double s0) {
+      const Vec3 d = x[pb[q]] - x[pa[q]];
+      const double r = d.norm();
+      const Vec3 xh = sign * (d * (1.0 / r));
+      if (!(r > 0)) return;
+      const double ak = alpha[q] * k[q];
+      const double dd = ti.dot(xh);
+      const double pn = (ti - dd * xh).norm();
+      const double sp = pn > 1e-12 ? ak * s0 / pn : 0.0;
+      acc += (ak * c0 - sp * dd) * xh;
+      bsum += sp;
+    };
+    for (uint32_t e = ts_off[i]; e < ts_off[i + 1]; ++e)
+      add(ts_pairs[e], 1.0, cos_a[ts_pairs[e]], sin_a[ts_pairs[e]]);
+    for (uint32_t e = rs_off[i]; e < rs_off[i + 1]; ++e)
+      add(rs_pairs[e], -1.0, cos_b[rs_pairs[e]], sin_b[rs_pairs[e]]);
+    acc += bsum * ti;
+    const double an = acc.norm();
+    if (an > 1e-300 && std::isfinite(an)) ref[i] = acc / an;
+  }
+  detail::DirectionTermInputs tin{x.data(), t.data(),     pa.data(),    pb.data(),    alpha.data(),
+                                  k.data(), cos_a.data(), sin_a.data(), cos_b.data(), sin_b.data()};
+  detail::DirectionSumInputs din{ts_off.data(),   ts_pairs.data(), rs_off.data(),
+                                 rs_pairs.data(), nullptr,         root.data()};
+  for (int simd = 0; simd < 2; ++simd) {
+    const auto kern = detail::lcp_kernels(simd == 1);
+    if (simd == 1 && !kern.simd) GTEST_SKIP() << "no AVX2 on this CPU";
+    std::vector<Vec3> tt = t;
+    directions_by_kernel(kern.geometry_terms, tin, np, din, 0, n, tt.data());
+    for (std::size_t i = 0; i < n; ++i)
+      ASSERT_TRUE(same_bits(tt[i], ref[i])) << "simd " << simd << " particle " << i << ": "
+                                            << tt[i].transpose() << " vs " << ref[i].transpose();
+  }
 }
 
 TEST(LcpKernels, GatherBalancesEveryPairAndSpring) {
