@@ -118,6 +118,28 @@ TEST(LcpInit, ParticlesFillThePillarAndRootsAreBelowTheScalp) {
   EXPECT_LT(m.h, m.spacing);
 }
 
+TEST(LcpInit, ParticlesAreNumberedAlongAZOrderCurve) {
+  // Neighbours in space are neighbours in memory: the index distance |a - b| of the connections
+  // is a small fraction of the particle count (random numbering, as dart throwing gives, would
+  // make it about n / 3), and consecutive particles are close in space.
+  Context ctx(2);
+  auto sc = test::lcp_small_scene(ctx);
+  const auto& m = sc.init.model;
+  const std::size_t n = m.size();
+  ASSERT_GT(n, 200u);
+  double gap = 0;
+  for (std::size_t q = 0; q < m.num_pairs(); ++q)
+    gap += std::abs(double(m.pair_a[q]) - double(m.pair_b[q]));
+  gap /= double(m.num_pairs());
+  EXPECT_LT(gap, 0.08 * double(n)) << "mean index distance of a connection";
+  double step = 0, any = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    step += (m.rest_x[i] - m.rest_x[i - 1]).norm();
+    any += (m.rest_x[i] - m.rest_x[(i * 7919) % n]).norm();
+  }
+  EXPECT_LT(step, 0.4 * any) << "consecutive particles against scattered ones";
+}
+
 TEST(LcpInit, RootDirectionFollowsTheWhirl) {
   // (3.4) at the whirl itself the tangential part vanishes: t_r = w_n n.
   const Vec3 n(0, 1, 0);
