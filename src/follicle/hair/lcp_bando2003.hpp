@@ -226,7 +226,8 @@ struct LcpInit {
 
 /// Poisson-disc sampling of the (u, v, s) pillar with (3.2), root directions (3.4), mapping
 /// back (3.3) along a cantilever-beam shape, and connections. `body` (optional, head frame)
-/// keeps the initial chains outside the body. Deterministic for ctx.seed().
+/// keeps the initial chains outside the body. Particles are numbered along a Z-order curve of
+/// their initial positions (neighbours near in memory). Deterministic for ctx.seed().
 LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitParams& p,
                        const sim::VoxelPlanes* body = nullptr);
 
