@@ -288,6 +288,37 @@ Chain cantilever_chain(const ScalpPoint& sp, const Vec3& tr, double L, double s,
   return {x, d};
 }
 
+// The order of the points along a Morton (Z-order) curve over their bounding box (21 bits per
+// axis; ties keep the input order).
+std::vector<uint32_t> zorder(const std::vector<Vec3>& x) {
+  const std::size_t n = x.size();
+  Vec3 lo = x[0], hi = x[0];
+  for (const Vec3& xi : x) {
+    lo = lo.cwiseMin(xi);
+    hi = hi.cwiseMax(xi);
+  }
+  const double ext = std::max((hi - lo).maxCoeff(), 1e-12);
+  auto spread = [](uint64_t v) {  // 21 bits -> every third bit
+    v &= 0x1FFFFF;
+    v = (v | v << 32) & 0x1F00000000FFFFull;
+    v = (v | v << 16) & 0x1F0000FF0000FFull;
+    v = (v | v << 8) & 0x100F00F00F00F00Full;
+    v = (v | v << 4) & 0x10C30C30C30C30C3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+  };
+  std::vector<uint64_t> code(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 f = (x[i] - lo) / ext * double((1 << 21) - 1);
+    code[i] = spread(uint64_t(f.x())) | spread(uint64_t(f.y())) << 1 | spread(uint64_t(f.z())) << 2;
+  }
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return code[a] < code[b]; });
+  return order;
+}
+
 }  // namespace
 
 std::vector<char> lcp_attached(const LcpModel& m) {
@@ -390,31 +421,7 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
   // (dart throwing alone numbers them in random order over the scalp, and every loop then reads
   // much of what the other core has just written).
   {
-    Vec3 lo = x[0], hi = x[0];
-    for (const Vec3& xi : x) {
-      lo = lo.cwiseMin(xi);
-      hi = hi.cwiseMax(xi);
-    }
-    const double ext = std::max((hi - lo).maxCoeff(), 1e-12);
-    auto spread = [](uint64_t v) {  // 21 bits -> every third bit
-      v &= 0x1FFFFF;
-      v = (v | v << 32) & 0x1F00000000FFFFull;
-      v = (v | v << 16) & 0x1F0000FF0000FFull;
-      v = (v | v << 8) & 0x100F00F00F00F00Full;
-      v = (v | v << 4) & 0x10C30C30C30C30C3ull;
-      v = (v | v << 2) & 0x1249249249249249ull;
-      return v;
-    };
-    std::vector<uint64_t> code(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 f = (x[i] - lo) / ext * double((1 << 21) - 1);
-      code[i] =
-          spread(uint64_t(f.x())) | spread(uint64_t(f.y())) << 1 | spread(uint64_t(f.z())) << 2;
-    }
-    std::vector<uint32_t> order(n);
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](uint32_t a, uint32_t b) { return code[a] < code[b]; });
+    const std::vector<uint32_t> order = zorder(x);
     auto permute = [&](std::vector<Vec3>& v) {
       std::vector<Vec3> o(n);
       for (std::size_t i = 0; i < n; ++i) o[i] = v[order[i]];

@@ -256,27 +256,14 @@ TEST(LcpKernels, DirectionUpdateFollowsItsConnections) {
       rs_off{0, 1, 1, 1, 2, 2, 2, 2, 2, 2}, rs_pairs{1, 3};
   std::vector<Vec3> t{Vec3(0, 0, 1), Vec3::UnitY(), Vec3::UnitY(), Vec3::UnitX(), Vec3::UnitX(),
                       Vec3::UnitX(), Vec3::UnitX(), Vec3::UnitX(), Vec3::UnitX()};
-  detail::DirectionTermInputs tin;
-  tin.x = x.data();
-  tin.t = t.data();
-  tin.pair_a = pa.data();
-  tin.pair_b = pb.data();
-  tin.alpha = alpha.data();
-  tin.k = k.data();
-  tin.cos_a = cos_a.data();
-  tin.sin_a = sin_a.data();
-  tin.cos_b = cos_b.data();
-  tin.sin_b = sin_b.data();
-  detail::DirectionSumInputs din;
-  din.ts_off = ts_off.data();
-  din.ts_pairs = ts_pairs.data();
-  din.rs_off = rs_off.data();
-  din.rs_pairs = rs_pairs.data();
-  din.root = root.data();
+  const detail::DirectionTermInputs tin{x.data(),     t.data(),    pa.data(),    pb.data(),
+                                        alpha.data(), k.data(),    cos_a.data(), sin_a.data(),
+                                        cos_b.data(), sin_b.data()};
+  const detail::DirectionSumInputs din{ts_off.data(),   ts_pairs.data(), rs_off.data(),
+                                       rs_pairs.data(), nullptr,         root.data()};
   for (int simd = 0; simd < 2; ++simd) {
     const auto kern = detail::lcp_kernels(simd == 1);
     std::vector<Vec3> tt = t;
-    tin.t = t.data();
     directions_by_kernel(kern.geometry_terms, tin, pa.size(), din, 0, 4, tt.data());
     EXPECT_LT((tt[0] - e).norm(), 1e-15) << tt[0].transpose();
     EXPECT_TRUE(tt[1] == Vec3::UnitY());
