@@ -690,6 +690,47 @@ void LcpSolver::rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWor
   ++ws.nbr_builds;
 }
 
+bool LcpSolver::lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& ws,
+                           double lim) const {
+  // A pair now closer than 2h was closer than 2h + |d_i - d_j| at the build (d: displacement
+  // since then), and |d_i - d_j| <= |d_i - u| + |d_j - u| for any common shift u. So the lists
+  // hold every pair within 2h while max_i |d_i - u| < skin / 2 for some u (lim is a little below
+  // skin / 2, clear of rounding). The chunks measured u = 0 (the classic test) and u = the shift
+  // of the last check; when both fail, u = the centre of the box of all displacements is tried,
+  // which halves the bound when the hair moves as a whole (wind, head motion with the roots
+  // fixed).
+  const double lim2 = lim * lim;
+  double d2 = 0, c2 = 0;
+  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+  bool finite = true;
+  for (const auto& c : ws.chunk_shift) {
+    d2 = std::max(d2, c.d2);
+    c2 = std::max(c2, c.c2);
+    lo = lo.cwiseMin(c.lo);
+    hi = hi.cwiseMax(c.hi);
+    finite = finite && c.finite;
+  }
+  // Non-finite positions: the blow-up check of this sub-step reports them (no list build over
+  // them).
+  if (!finite) return true;
+  if (d2 < lim2) return true;
+  if (c2 < lim2) return true;
+  const Vec3 u = 0.5 * (lo + hi);
+  const std::size_t n = s.x.size();
+  const double e2 = deterministic_reduce(
+      ctx, n, 4096, 0.0,
+      [&](std::size_t i0, std::size_t i1) {
+        double m = 0;
+        for (std::size_t i = i0; i < i1; ++i)
+          m = std::max(m, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
+  if (!(e2 < lim2)) return false;
+  ws.nbr_shift = u;
+  return true;
+}
+
 namespace {
 /// For sorted and mirrored lists: the first entry of each list with a neighbour index above the
 /// particle's own (nbr_upper), the pair slots of each particle (pair_off) and the pair slot of
@@ -782,16 +823,13 @@ detail::SpringInputs LcpSolver::spring_inputs(const LcpState& s, LcpWorkspace& w
 
 void LcpSolver::active_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws,
                                 const detail::HairPairConsts& pc) const {
-  // W(h, r) of every pair slot of the particles of chunk c (0 beyond 2h), the compact list of
-  // the pairs that interact (0 < r < 2h) and a zero force in every slot (the interacting ones
-  // are overwritten by hair_pairs_of).
+  // W(h, r) of every pair slot of the particles of chunk c (0 beyond 2h) and the compact list of
+  // the pairs that interact (0 < r < 2h).
   const std::size_t n = m_model.size();
   const std::size_t s0 = ws.pair_off[c * kChunk], s1 = ws.pair_off[std::min(n, (c + 1) * kChunk)];
   ws.act_count[c] = uint32_t(m_kernels.active(s.x.data(), ws.pair_i.data(), ws.pair_j.data(), pc,
                                               s0, s1, ws.pair_w.data(), ws.act_i.data(),
                                               ws.act_j.data(), ws.act_slot.data()));
-  std::fill(ws.pair_f.begin() + std::ptrdiff_t(s0), ws.pair_f.begin() + std::ptrdiff_t(s1),
-            Vec3::Zero());
 }
 
 detail::HairPairConsts LcpSolver::pair_consts(const SphKernel& K, double inv_w0) const {
@@ -812,7 +850,12 @@ void LcpSolver::hair_pairs_of(std::size_t c, const LcpState& s, LcpWorkspace& ws
   // chunk: AVX2 runs across pairs of different particles (a particle has only about three).
   const detail::HairPairInputs in{s.x.data(), s.v.data(), s.t.data(), m_model.mass.data(),
                                   ws.p_rho2.data()};
-  const std::size_t s0 = ws.pair_off[c * kChunk];
+  const std::size_t n = m_model.size();
+  const std::size_t s0 = ws.pair_off[c * kChunk], s1 = ws.pair_off[std::min(n, (c + 1) * kChunk)];
+  // A zero force in every slot of the chunk, then the interacting ones: the slots are still in
+  // cache when the kernel writes (a separate fill pass streamed the whole array once more).
+  std::fill(ws.pair_f.begin() + std::ptrdiff_t(s0), ws.pair_f.begin() + std::ptrdiff_t(s1),
+            Vec3::Zero());
   m_kernels.forces(in, pc, ws.act_i.data() + s0, ws.act_j.data() + s0, ws.act_slot.data() + s0,
                    ws.act_count[c], ws.pair_f.data());
 }
@@ -1002,7 +1045,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.contact.assign(n, 0);
   ws.penetration.assign(n, 0.0);
   const std::size_t nchunks = (n + kChunk - 1) / kChunk;
-  ws.chunk_max.resize(nchunks);
+  ws.chunk_shift.resize(nchunks);
   ws.chunk_check.resize(nchunks);
   const double h = m.h;
   const SphKernel K(h);
@@ -1030,22 +1073,24 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       pair_scratch(ws);
     }
     for (int attempt = 0; attempt < 2; ++attempt) {
+      const Vec3 u = rebuild ? Vec3::Zero() : ws.nbr_shift;
       parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
-        double dmax = 0;
+        LcpWorkspace::ChunkShift cs;
         for (std::size_t i = i0; i < i1; ++i) {
           if (do_alpha) coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
           if (!hh) continue;
-          dmax = std::max(dmax, (s.x[i] - ws.nbr_built_x[i]).squaredNorm());
+          cs.add(s.x[i] - ws.nbr_built_x[i], u);
         }
         if (hh) active_pairs_of(i0 / kChunk, s, ws, pc);
-        ws.chunk_max[i0 / kChunk] = dmax;
+        ws.chunk_shift[i0 / kChunk] = cs;
       });
-      if (!hh || rebuild) break;
-      double d2 = 0;
-      for (double d : ws.chunk_max) d2 = std::max(d2, d);
-      const double lim = 0.49 * skin;
-      if (d2 < lim * lim) break;  // the lists still hold every pair within 2h
-      // Some particle moved more than half the skin: rebuild and redo (also when NaN).
+      if (!hh) break;
+      if (rebuild) {
+        ws.nbr_shift = Vec3::Zero();
+        break;
+      }
+      if (lists_hold(ctx, s, ws, 0.49 * skin)) break;  // every pair within 2h is still listed
+      // The particles moved apart by more than the skin allows: rebuild and redo.
       rebuild = true;
       rebuild_neighbours(ctx, s, ws);
       pair_index(ctx, ws);

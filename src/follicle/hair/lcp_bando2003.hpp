@@ -205,7 +205,22 @@ struct LcpWorkspace {
   // (detail::lcp_geometry_terms), computed with the geometry.
   std::vector<double> dir_term;
   const void* geom_owner = nullptr;  // the solver that computed conn_r / conn_xh
-  std::vector<double> chunk_max;     // per-chunk reduction scratch
+  // Displacements d since the list build, per chunk (LcpSolver::lists_hold): max |d|^2, max
+  // |d - nbr_shift|^2 and the box of d.
+  struct ChunkShift {
+    double d2 = 0, c2 = 0;
+    Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+    bool finite = true;
+    void add(const Vec3& d, const Vec3& u) {
+      finite = finite && d.allFinite();
+      d2 = std::max(d2, d.squaredNorm());
+      c2 = std::max(c2, (d - u).squaredNorm());
+      lo = lo.cwiseMin(d);
+      hi = hi.cwiseMax(d);
+    }
+  };
+  std::vector<ChunkShift> chunk_shift;
+  Vec3 nbr_shift = Vec3::Zero();  // common shift u of the last successful list check [m]
   struct ChunkCheck {
     double vmax = 0;
     std::size_t bad = SIZE_MAX;
@@ -279,6 +294,9 @@ class LcpSolver {
 
  private:
   void rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  /// Whether the Verlet lists still hold every pair within 2h, from ws.chunk_shift (may set
+  /// ws.nbr_shift).
+  bool lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& ws, double lim) const;
   void pair_forces_sorted(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
   // Per-particle pieces shared by the public functions and the fused sub-step of step().
   template <class R>

@@ -104,6 +104,10 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
   parallel_for(
       ctx, 0, nh, [&](std::size_t i) { impulse[i] = Vec3::Zero(); }, 4096);
   if (nh) m_hair_grid.build(ctx, hair_x, rc);
+  m_mu.resize(nh);  // reduced mass of each hair particle with an air particle
+  parallel_for(
+      ctx, 0, nh, [&](std::size_t i) { m_mu[i] = hair_mass[i] * m_mass / (hair_mass[i] + m_mass); },
+      4096);
   double t = 0;
   int guard = 0;
   while (t < dt - 1e-12 && guard++ < 100000) {
@@ -119,17 +123,18 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     m_grid.neighbour_lists(ctx, m_x, 2 * h, m_off, m_nb);
     m_rho.resize(n);
     m_pr.resize(n);
+    m_pr_rho2.resize(n);
     parallel_for(ctx, 0, n, [&](std::size_t i) {
       double rho = m_mass * K.w(0.0);
       for (uint32_t e = m_off[i]; e < m_off[i + 1]; ++e)
         rho += m_mass * K.w((m_x[m_nb[e]] - m_x[i]).norm());  // (3.1)
       m_rho[i] = rho;
       m_pr[i] = m_p.k_p * std::max(rho - m_rho0, 0.0);
+      m_pr_rho2[i] = m_pr[i] / (rho * rho);  // P/rho^2 of (3.16), once per particle
     });
     auto drag_on_hair = [&](std::size_t hi, std::size_t ai) -> Vec3 {
       const double r = (m_x[ai] - hair_x[hi]).norm();
-      const double mu = hair_mass[hi] * m_mass / (hair_mass[hi] + m_mass);
-      return m_p.drag * mu * (Kc.w(r) * inv_wc0) * (m_v[ai] - hair_v[hi]);
+      return m_p.drag * m_mu[hi] * (Kc.w(r) * inv_wc0) * (m_v[ai] - hair_v[hi]);
     };
     // Air-hair pairs: lists from each air particle to the hair within rc; the drag of each pair
     // is evaluated once (force on the hair particle, the air particle gets the negation) and
@@ -152,7 +157,7 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     m_acc.resize(n);
     parallel_for(ctx, 0, n, [&](std::size_t i) {
       Vec3 f = Vec3::Zero();
-      const double pi = m_pr[i] / (m_rho[i] * m_rho[i]);
+      const double pi = m_pr_rho2[i];
       for (uint32_t e = m_off[i]; e < m_off[i + 1]; ++e) {
         const uint32_t j = m_nb[e];
         const Vec3 d = m_x[j] - m_x[i];
@@ -161,7 +166,7 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
         double w, dw;
         K.w_dw(r, w, dw);
         // (3.16) -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) grad_i W, grad_i W = -W'(r) d/r
-        f += (m_mass * m_mass * (pi + m_pr[j] / (m_rho[j] * m_rho[j])) * dw / r) * d;
+        f += (m_mass * m_mass * (pi + m_pr_rho2[j]) * dw / r) * d;
       }
       if (nh)
         for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) f -= m_drag[e];
