@@ -89,12 +89,12 @@ class SphAir {
   std::vector<Vec3> m_x, m_v;
   // scratch
   ParticleGrid m_grid, m_hair_grid;
-  std::vector<uint32_t> m_off, m_nb, m_hoff, m_hnb, m_aoff, m_anb;
+  std::vector<uint32_t> m_off, m_nb, m_aoff, m_anb;
   std::vector<double> m_rho, m_pr, m_pr_rho2;  // density, pressure, P/rho^2 per air particle
   std::vector<double> m_mu;                    // reduced mass per hair particle
   std::vector<Vec3> m_acc, m_drag;  // m_drag: air-hair drag on the hair per air-list entry
   std::vector<Vec3> m_impulse;      // drag impulse on each hair particle over a step
-  std::vector<uint32_t> m_fill;
+  std::vector<Vec3> m_hair_sum;     // drag on each hair particle in one sub-step
 };
 
 }  // namespace follicle::hair
