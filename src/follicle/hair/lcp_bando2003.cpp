@@ -1003,7 +1003,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.conn_r.resize(np);
   ws.conn_xh.resize(np);
   ws.dir_term.resize(8 * np);
-  ws.geom_owner = nullptr;  // set again below once it matches s.x
+  ws.geom_owner = nullptr;                  // set again below once it matches s.x
+  if (!geom_valid) ws.shift_ready = false;  // the positions are not those measured last
   if (!geom_valid)
     parallel_chunks(ctx, np, kChunk,
                     [&](std::size_t q0, std::size_t q1) { geometry_of(q0, q1, s, ws); });
@@ -1066,35 +1067,40 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     if (hh) {
       rebuild = skin <= 0 || ws.nbr_built_x.size() != n || ws.nbr_radius != Rn ||
                 ws.nbr_offsets.size() != n + 1 || ws.nbr_mirror.size() != ws.nbrs.size();
+      // The displacements were measured at the end of the last sub-step (same positions): a
+      // failed check rebuilds before the pass below instead of redoing it.
+      if (!rebuild && ws.shift_ready) {
+        rebuild = !lists_hold(ctx, s, ws, 0.49 * skin);
+        if (rebuild) ++ws.nbr_early_builds;
+      }
       if (rebuild) rebuild_neighbours(ctx, s, ws);
       if (rebuild || ws.nbr_upper.size() != n || ws.pair_off.size() != n + 1 ||
           ws.nbr_pair.size() != ws.nbrs.size())
         pair_index(ctx, ws);
       pair_scratch(ws);
     }
+    const bool checked = rebuild || ws.shift_ready;  // no displacement test in the pass
+    ws.shift_ready = false;
+    if (rebuild) ws.nbr_shift = Vec3::Zero();
     for (int attempt = 0; attempt < 2; ++attempt) {
-      const Vec3 u = rebuild ? Vec3::Zero() : ws.nbr_shift;
+      const Vec3 u = ws.nbr_shift;
       parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
         LcpWorkspace::ChunkShift cs;
         for (std::size_t i = i0; i < i1; ++i) {
           if (do_alpha) coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
-          if (!hh) continue;
-          cs.add(s.x[i] - ws.nbr_built_x[i], u);
+          if (hh && !checked) cs.add(s.x[i] - ws.nbr_built_x[i], u);
         }
         if (hh) active_pairs_of(i0 / kChunk, s, ws, pc);
         ws.chunk_shift[i0 / kChunk] = cs;
       });
-      if (!hh) break;
-      if (rebuild) {
-        ws.nbr_shift = Vec3::Zero();
-        break;
-      }
+      if (!hh || checked) break;
       if (lists_hold(ctx, s, ws, 0.49 * skin)) break;  // every pair within 2h is still listed
       // The particles moved apart by more than the skin allows: rebuild and redo.
       rebuild = true;
       rebuild_neighbours(ctx, s, ws);
       pair_index(ctx, ws);
       pair_scratch(ws);
+      ws.nbr_shift = Vec3::Zero();
     }
     // 2. alpha sums (3.13), density (3.1) and pressure.
     parallel_for(
@@ -1171,9 +1177,17 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     });
     const double vlim = P.max_speed;
     const detail::DirectionSumInputs din = direction_sum_inputs(ws.dir_term.data());
+    // With the hair-hair lists: the displacement since their build, for the next sub-step's test.
+    const bool measure = hh && ws.nbr_built_x.size() == n;
+    const Vec3 u = ws.nbr_shift;
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
       detail::lcp_direction_sum(din, i0, i1, s.t.data());  // (3.15)
       LcpWorkspace::ChunkCheck c;
+      if (measure) {
+        LcpWorkspace::ChunkShift cs;
+        for (std::size_t i = i0; i < i1; ++i) cs.add(s.x[i] - ws.nbr_built_x[i], u);
+        ws.chunk_shift[i0 / kChunk] = cs;
+      }
       for (std::size_t i = i0; i < i1; ++i) {
         const double sp = s.v[i].norm();
         const bool bad =
@@ -1183,6 +1197,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       }
       ws.chunk_check[i0 / kChunk] = c;
     });
+    ws.shift_ready = measure;
     s.time += dt;
     rep.substeps = sub + 1;
     LcpWorkspace::ChunkCheck chk;

@@ -220,7 +220,9 @@ struct LcpWorkspace {
     }
   };
   std::vector<ChunkShift> chunk_shift;
-  Vec3 nbr_shift = Vec3::Zero();  // common shift u of the last successful list check [m]
+  Vec3 nbr_shift = Vec3::Zero();     // common shift u of the last successful list check [m]
+  bool shift_ready = false;          // chunk_shift holds the displacements of the current positions
+  std::size_t nbr_early_builds = 0;  // builds decided before a sub-step's first pass (statistics)
   struct ChunkCheck {
     double vmax = 0;
     std::size_t bad = SIZE_MAX;

@@ -92,7 +92,7 @@ TEST(LcpVerlet, SkinChangesNothingButTheRebuildCount) {
   auto sc = test::lcp_small_scene(ctx, 0.016);
   const auto track = anim::RigidMotionTrack::shake(Vec3::Zero(), Vec3::UnitY(), 0.7, 2, 0.0, 0.75);
   std::vector<Vec3> out[2];
-  std::size_t builds[2] = {0, 0};
+  std::size_t builds[2] = {0, 0}, early = 0;
   int substeps = 0;
   for (int k = 0; k < 2; ++k) {
     LcpParams p;
@@ -112,14 +112,53 @@ TEST(LcpVerlet, SkinChangesNothingButTheRebuildCount) {
     out[k].insert(out[k].end(), s.v.begin(), s.v.end());
     out[k].insert(out[k].end(), s.t.begin(), s.t.end());
     builds[k] = ws.nbr_builds;
+    if (k == 1) early = ws.nbr_early_builds;
   }
   ASSERT_EQ(out[0].size(), out[1].size());
   for (std::size_t i = 0; i < out[0].size(); ++i) ASSERT_TRUE(out[0][i] == out[1][i]) << i;
   EXPECT_EQ(builds[0], std::size_t(substeps));
+  // Most rebuilds were decided from the displacements measured at the end of the sub-step
+  // before (the first pass of the sub-step is then not run twice).
+  EXPECT_GT(early, 0u);
+  EXPECT_LE(early, builds[1]);
   EXPECT_GT(builds[1], 1u);             // the shake moved particles by more than the skin
   EXPECT_LT(builds[1] * 2, builds[0]);  // but far fewer rebuilds than sub-steps
   std::printf("Verlet lists: %zu builds for %d sub-steps (without skin: %zu)\n", builds[1],
               substeps, builds[0]);
+}
+
+TEST(LcpVerlet, PositionsScatteredBetweenStepsRebuildTheLists) {
+  // The displacement test of a sub-step may use the displacements measured at the end of the
+  // last one, but not when the caller moved particles in between: here by random offsets of up
+  // to 1.5 skins per axis (new pairs come within 2h), which must give what lists rebuilt every
+  // sub-step give, bit for bit.
+  Context ctx(2);
+  auto sc = test::lcp_small_scene(ctx, 0.016);
+  std::vector<Vec3> out[2];
+  for (int k = 0; k < 2; ++k) {
+    LcpParams p;
+    p.cfl = 0;
+    p.substeps = 2;
+    p.neighbour_skin = k == 0 ? 0.0 : 0.15;
+    LcpSolver solver(p, sc.init.model, &sc.body);
+    LcpState s = solver.rest_state();
+    LcpWorkspace ws;
+    LcpStepInput in;
+    in.dt = 1e-4;
+    Rng rng(5);
+    const double skin = 0.15 * 2 * solver.model().h;
+    for (int f = 0; f < 4; ++f) {
+      ASSERT_TRUE(solver.step(ctx, in, s, ws).ok);
+      for (std::size_t i = 0; i < s.x.size(); ++i)
+        if (!solver.model().root[i])
+          s.x[i] += Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 3 * skin;
+    }
+    out[k] = s.x;
+    out[k].insert(out[k].end(), s.v.begin(), s.v.end());
+    out[k].insert(out[k].end(), s.t.begin(), s.t.end());
+  }
+  ASSERT_EQ(out[0].size(), out[1].size());
+  for (std::size_t i = 0; i < out[0].size(); ++i) ASSERT_TRUE(out[0][i] == out[1][i]) << i;
 }
 
 TEST(LcpVerlet, ParallelGridBuildMatchesSerialBuild) {
