@@ -192,6 +192,35 @@ void lcp_gather(const GatherInputs& in, std::size_t i0, std::size_t i1, Vec3* fo
   }
 }
 
+void air_density(const AirInputs& in, std::size_t i0, std::size_t i1, double* rho) {
+  const SphKernel& K = in.kernel;
+  for (std::size_t i = i0; i < i1; ++i) {
+    double r = in.mass * K.w(0.0);
+    for (uint32_t e = in.off[i]; e < in.off[i + 1]; ++e)
+      r += in.mass * K.w((in.x[in.nb[e]] - in.x[i]).norm());  // (3.1)
+    rho[i] = r;
+  }
+}
+
+void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) {
+  const SphKernel& K = in.kernel;
+  for (std::size_t i = i0; i < i1; ++i) {
+    Vec3 s = Vec3::Zero();
+    const double pi = in.p_rho2[i];
+    for (uint32_t e = in.off[i]; e < in.off[i + 1]; ++e) {
+      const uint32_t j = in.nb[e];
+      const Vec3 d = in.x[j] - in.x[i];
+      const double r = d.norm();
+      if (r <= 0) continue;
+      double w, dw;
+      K.w_dw(r, w, dw);
+      // (3.16) -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) grad_i W, grad_i W = -W'(r) d/r
+      s += (in.mass * in.mass * (pi + in.p_rho2[j]) * dw / r) * d;
+    }
+    f[i] = s;
+  }
+}
+
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
 #pragma GCC push_options
 // AVX2 without FMA: no contraction, so each lane rounds exactly as the scalar code.
@@ -429,6 +458,79 @@ void geometry_terms(const DirectionTermInputs& in, std::size_t q0, std::size_t q
   lcp_geometry_terms(in, q, q1, r, xh, term);
 }
 
+// air_density / air_pressure with four list entries per step; the sums stay sequential.
+struct AirEntries {
+  V r, a, b, dx, dy, dz;  // |x_j - x_i|, (2 - q)_+, (1 - q)_+, x_j - x_i
+};
+inline AirEntries air_entries(const AirInputs& in, const uint32_t* nb, const Vec3& xi) {
+  const V zero = splat(0.0), one = splat(1.0), two = splat(2.0);
+  const V3 xj = load3(in.x, nb);
+  AirEntries E;
+  E.dx = xj.x - splat(xi.x());
+  E.dy = xj.y - splat(xi.y());
+  E.dz = xj.z - splat(xi.z());
+  E.r = vsqrt(E.dx * E.dx + E.dy * E.dy + E.dz * E.dz);
+  const V q = E.r * splat(in.kernel.inv_h);
+  E.a = two - q;
+  E.b = one - q;
+  E.a = E.a < zero ? zero : E.a;  // std::max(., 0.0)
+  E.b = E.b < zero ? zero : E.b;
+  return E;
+}
+
+void air_density(const AirInputs& in, std::size_t i0, std::size_t i1, double* rho) {
+  const V m = splat(in.mass), four = splat(4.0), sw = splat(in.kernel.sigma_w * 0.25);
+  for (std::size_t i = i0; i < i1; ++i) {
+    const Vec3 xi = in.x[i];
+    double r = in.mass * in.kernel.w(0.0);
+    uint32_t e = in.off[i];
+    const uint32_t e1 = in.off[i + 1];
+    for (; e + 4 <= e1; e += 4) {
+      const AirEntries E = air_entries(in, in.nb + e, xi);
+      const V mw = m * (sw * (E.a * E.a * E.a - four * E.b * E.b * E.b));  // SphKernel::w
+      for (int l = 0; l < 4; ++l) r += mw[l];
+    }
+    for (; e < e1; ++e) r += in.mass * in.kernel.w((in.x[in.nb[e]] - xi).norm());
+    rho[i] = r;
+  }
+}
+
+void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) {
+  const V four = splat(4.0), zero = splat(0.0), sdw = splat(in.kernel.sigma_dw * 0.75);
+  const double mm = in.mass * in.mass;
+  for (std::size_t i = i0; i < i1; ++i) {
+    const Vec3 xi = in.x[i];
+    const double pi = in.p_rho2[i];
+    double sx = 0, sy = 0, sz = 0;
+    uint32_t e = in.off[i];
+    const uint32_t e1 = in.off[i + 1];
+    for (; e + 4 <= e1; e += 4) {
+      const AirEntries E = air_entries(in, in.nb + e, xi);
+      const V dw = sdw * (four * E.b * E.b - E.a * E.a);  // SphKernel::w_dw
+      const V c = splat(mm) * (splat(pi) + load1(in.p_rho2, in.nb + e)) * dw / E.r;
+      const V px = c * E.dx, py = c * E.dy, pz = c * E.dz;
+      const auto skip = E.r <= zero;
+      for (int l = 0; l < 4; ++l)
+        if (!skip[l]) {
+          sx += px[l];
+          sy += py[l];
+          sz += pz[l];
+        }
+    }
+    Vec3 s(sx, sy, sz);
+    for (; e < e1; ++e) {
+      const uint32_t j = in.nb[e];
+      const Vec3 d = in.x[j] - xi;
+      const double r = d.norm();
+      if (r <= 0) continue;
+      double w, dw;
+      in.kernel.w_dw(r, w, dw);
+      s += (mm * (pi + in.p_rho2[j]) * dw / r) * d;
+    }
+    f[i] = s;
+  }
+}
+
 }  // namespace avx2
 #pragma GCC pop_options
 #endif
@@ -436,11 +538,12 @@ void geometry_terms(const DirectionTermInputs& in, std::size_t q0, std::size_t q
 LcpKernels lcp_kernels(bool allow_simd) {
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
   if (allow_simd && __builtin_cpu_supports("avx2"))
-    return {&avx2::active,   &avx2::batch,          &avx2::springs,
-            &avx2::geometry, &avx2::geometry_terms, true};
+    return {&avx2::active,         &avx2::batch,       &avx2::springs,      &avx2::geometry,
+            &avx2::geometry_terms, &avx2::air_density, &avx2::air_pressure, true};
 #endif
   (void)allow_simd;
-  return {&active_scalar, &batch_scalar, &lcp_springs, &lcp_geometry, &lcp_geometry_terms, false};
+  return {&active_scalar,      &batch_scalar, &lcp_springs,  &lcp_geometry,
+          &lcp_geometry_terms, &air_density,  &air_pressure, false};
 }
 
 }  // namespace follicle::hair::detail

@@ -9,6 +9,8 @@
 // (ADR 0008). The connection geometry with the terms of the direction update (3.15) and the
 // springs (one connection per lane) have AVX2 versions too; the per-particle sums (force gather,
 // (3.15)) are scalar: AVX2 versions with one particle per lane measured nothing (ADR 0008).
+// The SPH air's density and pressure loops evaluate four list entries per instruction and add
+// them to the particle's sum one by one in list order (same bits as the scalar loops).
 #include <cstddef>
 #include <cstdint>
 
@@ -139,12 +141,34 @@ void lcp_geometry(const Vec3* x, const uint32_t* pair_a, const uint32_t* pair_b,
 using GeometryFn = void (*)(const Vec3* x, const uint32_t* pair_a, const uint32_t* pair_b,
                             std::size_t q0, std::size_t q1, double* r, Vec3* xh);
 
+/// SPH air (§3.6, hair/sph_air_bando2003): particles of one mass with CSR neighbour lists
+/// (particle i: entries off[i] .. off[i + 1] - 1 of nb).
+struct AirInputs {
+  const Vec3* x = nullptr;
+  const uint32_t* off = nullptr;
+  const uint32_t* nb = nullptr;
+  double mass = 0;
+  SphKernel kernel{1.0};
+  const double* p_rho2 = nullptr;  // P_i / rho_i^2 (air_pressure only)
+};
+
+/// Density (3.1) rho_i = m W(0) + sum_e m W(|x_nb[e] - x_i|), in list order, for i0 <= i < i1.
+void air_density(const AirInputs& in, std::size_t i0, std::size_t i1, double* rho);
+/// Pressure force (3.16) on i, f_i = sum_e m^2 (P_i/rho_i^2 + P_j/rho_j^2) W'(r) / r (x_j -
+/// x_i) over the entries with r = |x_j - x_i| > 0, in list order, for i0 <= i < i1.
+void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f);
+
+using AirDensityFn = void (*)(const AirInputs& in, std::size_t i0, std::size_t i1, double* rho);
+using AirPressureFn = void (*)(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f);
+
 struct LcpKernels {
   ActivePairsFn active = nullptr;
   HairPairBatchFn forces = nullptr;
   SpringsFn springs = nullptr;
   GeometryFn geometry = nullptr;
   GeometryTermsFn geometry_terms = nullptr;
+  AirDensityFn air_density = nullptr;
+  AirPressureFn air_pressure = nullptr;
   bool simd = false;  // the AVX2 kernels
 };
 

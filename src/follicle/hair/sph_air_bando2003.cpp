@@ -9,6 +9,10 @@
 
 namespace follicle::hair {
 
+namespace {
+constexpr std::size_t kAirChunk = 256;  // air particles per task of the density/pressure loops
+}  // namespace
+
 void SphAirParams::validate() const {
   validate_params(*this, "sph_air");
   for (int k = 0; k < 3; ++k)
@@ -124,13 +128,20 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     m_rho.resize(n);
     m_pr.resize(n);
     m_pr_rho2.resize(n);
-    parallel_for(ctx, 0, n, [&](std::size_t i) {
-      double rho = m_mass * K.w(0.0);
-      for (uint32_t e = m_off[i]; e < m_off[i + 1]; ++e)
-        rho += m_mass * K.w((m_x[m_nb[e]] - m_x[i]).norm());  // (3.1)
-      m_rho[i] = rho;
-      m_pr[i] = m_p.k_p * std::max(rho - m_rho0, 0.0);
-      m_pr_rho2[i] = m_pr[i] / (rho * rho);  // P/rho^2 of (3.16), once per particle
+    detail::AirInputs ain;
+    ain.x = m_x.data();
+    ain.off = m_off.data();
+    ain.nb = m_nb.data();
+    ain.mass = m_mass;
+    ain.kernel = K;
+    ain.p_rho2 = m_pr_rho2.data();
+    parallel_chunks(ctx, n, kAirChunk, [&](std::size_t i0, std::size_t i1) {
+      m_kernels.air_density(ain, i0, i1, m_rho.data());  // (3.1)
+      for (std::size_t i = i0; i < i1; ++i) {
+        const double rho = m_rho[i];
+        m_pr[i] = m_p.k_p * std::max(rho - m_rho0, 0.0);
+        m_pr_rho2[i] = m_pr[i] / (rho * rho);  // P/rho^2 of (3.16), once per particle
+      }
     });
     auto drag_on_hair = [&](std::size_t hi, std::size_t ai) -> Vec3 {
       const double r = (m_x[ai] - hair_x[hi]).norm();
@@ -153,22 +164,14 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
       for (std::size_t e = 0; e < m_anb.size(); ++e) m_hair_sum[m_anb[e]] += m_drag[e];
     }
     m_acc.resize(n);
-    parallel_for(ctx, 0, n, [&](std::size_t i) {
-      Vec3 f = Vec3::Zero();
-      const double pi = m_pr_rho2[i];
-      for (uint32_t e = m_off[i]; e < m_off[i + 1]; ++e) {
-        const uint32_t j = m_nb[e];
-        const Vec3 d = m_x[j] - m_x[i];
-        const double r = d.norm();
-        if (r <= 0) continue;
-        double w, dw;
-        K.w_dw(r, w, dw);
-        // (3.16) -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) grad_i W, grad_i W = -W'(r) d/r
-        f += (m_mass * m_mass * (pi + m_pr_rho2[j]) * dw / r) * d;
+    parallel_chunks(ctx, n, kAirChunk, [&](std::size_t i0, std::size_t i1) {
+      m_kernels.air_pressure(ain, i0, i1, m_acc.data());  // (3.16)
+      for (std::size_t i = i0; i < i1; ++i) {
+        Vec3 f = m_acc[i];
+        if (nh)
+          for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) f -= m_drag[e];
+        m_acc[i] = f / m_mass;
       }
-      if (nh)
-        for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) f -= m_drag[e];
-      m_acc[i] = f / m_mass;
     });
     if (nh)
       parallel_for(

@@ -18,6 +18,7 @@
 #include "follicle/core/context.hpp"
 #include "follicle/core/params.hpp"
 #include "follicle/core/types.hpp"
+#include "follicle/hair/lcp_kernels_bando2003.hpp"
 #include "follicle/hair/particle_grid.hpp"
 #include "follicle/sim/step_report.hpp"
 
@@ -87,6 +88,7 @@ class SphAir {
   double m_mass = 0, m_h = 0, m_rho0 = 0;
   double m_phase = 0;  // distance the last inflow layer has travelled
   std::vector<Vec3> m_x, m_v;
+  detail::LcpKernels m_kernels = detail::lcp_kernels();  // density/pressure loops (AVX2 or not)
   // scratch
   ParticleGrid m_grid, m_hair_grid;
   std::vector<uint32_t> m_off, m_nb, m_aoff, m_anb;

@@ -571,3 +571,60 @@ TEST(LcpKernels, ConnectionGeometryIsTheUnitVectorAndLength) {
       }
     }
 }
+
+TEST(LcpKernels, AirDensityAndPressureGiveTheScalarBits) {
+  // The SPH air loops (§3.6): lists of random lengths (tails of 0-3 entries after the blocks of
+  // four) over particles on both kernel pieces and beyond 2h, with a coincident pair (r = 0:
+  // skipped by the pressure force) and a list entry of a particle to itself.
+  const double h = 0.01;
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::size_t n = 300;
+  std::vector<Vec3> x(n);
+  std::vector<double> p_rho2(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = Vec3(u(rng), u(rng), u(rng)) * 2.5 * h;
+    p_rho2[i] = 1e-3 * (1.2 + u(rng));
+  }
+  x[7] = x[3];
+  std::vector<uint32_t> off{0}, nb;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t len = rng() % 23;
+    for (std::size_t k = 0; k < len; ++k) nb.push_back(uint32_t(rng() % n));
+    if (i == 3) nb.push_back(7);
+    if (i == 9) nb.push_back(9);
+    off.push_back(uint32_t(nb.size()));
+  }
+  detail::AirInputs in;
+  in.x = x.data();
+  in.off = off.data();
+  in.nb = nb.data();
+  in.mass = 2.4e-6;
+  in.kernel = SphKernel(h);
+  in.p_rho2 = p_rho2.data();
+  const auto scalar = detail::lcp_kernels(false), fast = detail::lcp_kernels(true);
+  std::vector<double> rho_s(n), rho_f(n);
+  std::vector<Vec3> f_s(n), f_f(n);
+  scalar.air_density(in, 0, n, rho_s.data());
+  fast.air_density(in, 0, n, rho_f.data());
+  scalar.air_pressure(in, 0, n, f_s.data());
+  fast.air_pressure(in, 0, n, f_f.data());
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(std::memcmp(&rho_s[i], &rho_f[i], sizeof(double)), 0) << i;
+    ASSERT_TRUE(same_bits(f_s[i], f_f[i])) << i;
+    ASSERT_TRUE(f_s[i].allFinite()) << i;  // the coincident pair and the self entry are skipped
+  }
+  // Against the definitions: particle 3 lists 7 at r = 0 (density W(0), no force from it).
+  const SphKernel K(h);
+  double rho = in.mass * K.w(0.0);
+  Vec3 f = Vec3::Zero();
+  for (uint32_t e = off[3]; e < off[4]; ++e) {
+    const Vec3 d = x[nb[e]] - x[3];
+    const double r = d.norm();
+    rho += in.mass * sph_w(h, r);
+    if (r > 0) f += in.mass * in.mass * (p_rho2[3] + p_rho2[nb[e]]) * sph_dw(h, r) / r * d;
+  }
+  EXPECT_NEAR(rho_s[3], rho, 1e-12 * rho);
+  EXPECT_LT((f_s[3] - f).norm(), 1e-12 * (1 + f.norm()));
+  if (!fast.simd) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar loops were compared";
+}
