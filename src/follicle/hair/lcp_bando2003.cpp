@@ -7,6 +7,7 @@
 #include <cstring>
 #include <numeric>
 #include <unordered_map>
+#include <utility>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -695,28 +696,32 @@ bool LcpSolver::lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& 
   // A pair now closer than 2h was closer than 2h + |d_i - d_j| at the build (d: displacement
   // since then), and |d_i - d_j| <= |d_i - u| + |d_j - u| for any common shift u. So the lists
   // hold every pair within 2h while max_i |d_i - u| < skin / 2 for some u (lim is a little below
-  // skin / 2, clear of rounding). The chunks measured u = 0 (the classic test) and u = the shift
-  // of the last check; when both fail, u = the centre of the box of all displacements is tried,
-  // which halves the bound when the hair moves as a whole (wind, head motion with the roots
-  // fixed).
+  // skin / 2, clear of rounding). The chunks measured max |d - u|^2 for u = ws.nbr_shift (zero
+  // after a build: the classic test); when that fails, u = the centre of the box of all
+  // displacements is tried (two more passes), which halves the bound when the hair moves as a
+  // whole (wind, head motion with the roots fixed), and kept for the next checks.
   const double lim2 = lim * lim;
-  double d2 = 0, c2 = 0;
-  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-  bool finite = true;
-  for (const auto& c : ws.chunk_shift) {
-    d2 = std::max(d2, c.d2);
-    c2 = std::max(c2, c.c2);
-    lo = lo.cwiseMin(c.lo);
-    hi = hi.cwiseMax(c.hi);
-    finite = finite && c.finite;
-  }
-  // Non-finite positions: the blow-up check of this sub-step reports them (no list build over
-  // them).
-  if (!finite) return true;
-  if (d2 < lim2) return true;
+  double c2 = 0;
+  for (double c : ws.chunk_shift) c2 = std::max(c2, c);
   if (c2 < lim2) return true;
-  const Vec3 u = 0.5 * (lo + hi);
   const std::size_t n = s.x.size();
+  using Box = std::pair<Vec3, Vec3>;
+  const Box box = deterministic_reduce(
+      ctx, n, 4096, Box(Vec3::Constant(INFINITY), Vec3::Constant(-INFINITY)),
+      [&](std::size_t i0, std::size_t i1) {
+        Box b(Vec3::Constant(INFINITY), Vec3::Constant(-INFINITY));
+        for (std::size_t i = i0; i < i1; ++i) {
+          const Vec3 d = s.x[i] - ws.nbr_built_x[i];
+          b.first = b.first.cwiseMin(d);
+          b.second = b.second.cwiseMax(d);
+        }
+        return b;
+      },
+      [](const Box& a, const Box& b) {
+        return Box(a.first.cwiseMin(b.first), a.second.cwiseMax(b.second));
+      });
+  const Vec3 u = 0.5 * (box.first + box.second);
+  if (!u.allFinite()) return false;
   const double e2 = deterministic_reduce(
       ctx, n, 4096, 0.0,
       [&](std::size_t i0, std::size_t i1) {
@@ -1085,13 +1090,13 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     for (int attempt = 0; attempt < 2; ++attempt) {
       const Vec3 u = ws.nbr_shift;
       parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
-        LcpWorkspace::ChunkShift cs;
+        double c2 = 0;
         for (std::size_t i = i0; i < i1; ++i) {
           if (do_alpha) coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
-          if (hh && !checked) cs.add(s.x[i] - ws.nbr_built_x[i], u);
+          if (hh && !checked) c2 = std::max(c2, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
         }
         if (hh) active_pairs_of(i0 / kChunk, s, ws, pc);
-        ws.chunk_shift[i0 / kChunk] = cs;
+        ws.chunk_shift[i0 / kChunk] = c2;
       });
       if (!hh || checked) break;
       if (lists_hold(ctx, s, ws, 0.49 * skin)) break;  // every pair within 2h is still listed
@@ -1184,9 +1189,10 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       detail::lcp_direction_sum(din, i0, i1, s.t.data());  // (3.15)
       LcpWorkspace::ChunkCheck c;
       if (measure) {
-        LcpWorkspace::ChunkShift cs;
-        for (std::size_t i = i0; i < i1; ++i) cs.add(s.x[i] - ws.nbr_built_x[i], u);
-        ws.chunk_shift[i0 / kChunk] = cs;
+        double c2 = 0;
+        for (std::size_t i = i0; i < i1; ++i)
+          c2 = std::max(c2, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
+        ws.chunk_shift[i0 / kChunk] = c2;
       }
       for (std::size_t i = i0; i < i1; ++i) {
         const double sp = s.v[i].norm();

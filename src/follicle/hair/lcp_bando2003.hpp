@@ -205,21 +205,9 @@ struct LcpWorkspace {
   // (detail::lcp_geometry_terms), computed with the geometry.
   std::vector<double> dir_term;
   const void* geom_owner = nullptr;  // the solver that computed conn_r / conn_xh
-  // Displacements d since the list build, per chunk (LcpSolver::lists_hold): max |d|^2, max
-  // |d - nbr_shift|^2 and the box of d.
-  struct ChunkShift {
-    double d2 = 0, c2 = 0;
-    Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-    bool finite = true;
-    void add(const Vec3& d, const Vec3& u) {
-      finite = finite && d.allFinite();
-      d2 = std::max(d2, d.squaredNorm());
-      c2 = std::max(c2, (d - u).squaredNorm());
-      lo = lo.cwiseMin(d);
-      hi = hi.cwiseMax(d);
-    }
-  };
-  std::vector<ChunkShift> chunk_shift;
+  // max |d - nbr_shift|^2 per chunk, d the displacement since the list build
+  // (LcpSolver::lists_hold).
+  std::vector<double> chunk_shift;
   Vec3 nbr_shift = Vec3::Zero();     // common shift u of the last successful list check [m]
   bool shift_ready = false;          // chunk_shift holds the displacements of the current positions
   std::size_t nbr_early_builds = 0;  // builds decided before a sub-step's first pass (statistics)

@@ -502,48 +502,51 @@ bool sort_then_match(const Context& ctx, const std::vector<uint32_t>& offsets,
   return true;
 }
 
+/// Transposes the CSR lists `in` into `out` (same offsets): row j of out gets every i with j in
+/// row i of in, by increasing i. When `pos` is given, pos[e] receives the slot of out that entry
+/// e of in went to; with `expect`, every slot must already hold the i that goes there. Returns
+/// false when a row of out would overflow, an index is >= n, a row holds its own index (a self
+/// entry: no pair, though it is its own transpose) or `expect` differs (then the lists are not
+/// symmetric pair lists). Serial: one pass over the entries; two threads each scanning all entries
+/// for half of the rows measured slower (memory bound).
+bool transpose(const std::vector<uint32_t>& offsets, const uint32_t* in, uint32_t* out,
+               uint32_t* pos, const uint32_t* expect) {
+  const std::size_t n = offsets.size() - 1;
+  std::vector<uint32_t> cursor(offsets.begin(), offsets.end() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
+      const uint32_t j = in[e];
+      if (j >= n || j == i) return false;  // index beyond the particles, or a self entry
+      const uint32_t c = cursor[j]++;
+      if (c >= offsets[j + 1] || (expect && expect[c] != i)) return false;
+      if (out) out[c] = uint32_t(i);
+      if (pos) pos[e] = c;
+    }
+  return true;
+}
 }  // namespace
 
 bool sort_and_mirror(const Context& ctx, const std::vector<uint32_t>& offsets,
                      std::vector<uint32_t>& nbrs, std::vector<uint32_t>& mirror) {
-  // Fast path, parallel: each list sorted, then the mirror of entry e = (i -> j) found by binary
-  // search for i in the sorted list of j. Accepted only when every entry finds its reverse and
-  // mirror is an involution (mirror[mirror[e]] == e): then every index occurs at most once per
-  // list and the lists are symmetric, so the pairing is the only one and equals
-  // sort_then_match's. Otherwise (asymmetric lists, self entries, duplicates) sort_then_match
-  // gives the reference result (the lists are already sorted; sorting again changes nothing).
+  // Fast path: for symmetric lists the transpose T of the lists is the sorted lists (row j of T
+  // holds the i with j in list i, by increasing i), and transposing T once more pairs the k-th
+  // entry i of row j with the k-th entry j of row i, which is the pairing of the cursor
+  // algorithm. T is accepted only when it equals its own transpose; then the lists equal T as
+  // multisets, so the result is exactly sort_then_match's. Otherwise (asymmetric lists, self
+  // entries) the lists are restored and sort_then_match gives the rejection.
   const std::size_t n = offsets.empty() ? 0 : offsets.size() - 1;
   if (n == 0 || offsets[n] != nbrs.size() || offsets[0] != 0)
     return sort_then_match(ctx, offsets, nbrs, mirror);
-  parallel_for(
-      ctx, 0, n,
-      [&](std::size_t i) { std::sort(nbrs.begin() + offsets[i], nbrs.begin() + offsets[i + 1]); },
-      256);
   mirror.resize(nbrs.size());
-  const uint32_t* nb = nbrs.data();
-  const auto found = deterministic_reduce(
-      ctx, n, 1024, 1,
-      [&](std::size_t i0, std::size_t i1) {
-        for (std::size_t i = i0; i < i1; ++i)
-          for (uint32_t e = offsets[i]; e < offsets[i + 1]; ++e) {
-            const uint32_t j = nb[e];
-            if (j >= n || j == i) return 0;
-            const uint32_t* p = std::lower_bound(nb + offsets[j], nb + offsets[j + 1], uint32_t(i));
-            if (p == nb + offsets[j + 1] || *p != i) return 0;
-            mirror[e] = uint32_t(p - nb);
-          }
-        return 1;
-      },
-      [](int a, int b) { return a & b; });
-  const auto involution = found && deterministic_reduce(
-                                       ctx, nbrs.size(), 1 << 14, 1,
-                                       [&](std::size_t e0, std::size_t e1) {
-                                         for (std::size_t e = e0; e < e1; ++e)
-                                           if (mirror[mirror[e]] != e) return 0;
-                                         return 1;
-                                       },
-                                       [](int a, int b) { return a & b; });
-  if (!involution) return sort_then_match(ctx, offsets, nbrs, mirror);
+  if (!transpose(offsets, nbrs.data(), mirror.data(), nullptr, nullptr))
+    return sort_then_match(ctx, offsets, nbrs, mirror);  // nbrs untouched
+  // mirror holds T; nbrs' storage receives T's mirror entries.
+  if (!transpose(offsets, mirror.data(), nullptr, nbrs.data(), mirror.data())) {
+    // Not symmetric: rebuild the lists as the transpose of T, then take the reference path.
+    transpose(offsets, mirror.data(), nbrs.data(), nullptr, nullptr);
+    return sort_then_match(ctx, offsets, nbrs, mirror);
+  }
+  nbrs.swap(mirror);
   return true;
 }
 
