@@ -10,6 +10,30 @@
 using namespace follicle;
 using namespace follicle::hair;
 
+namespace {
+// x, v and t of a state one after another, to compare trajectories bit for bit.
+std::vector<Vec3> state_vectors(const LcpState& s) {
+  std::vector<Vec3> out = s.x;
+  out.insert(out.end(), s.v.begin(), s.v.end());
+  out.insert(out.end(), s.t.begin(), s.t.end());
+  return out;
+}
+
+// Fixed sub-steps; lists rebuilt every sub-step (k = 0: no skin) or kept (k = 1: skin 0.15).
+LcpParams fixed_params(int substeps, int k) {
+  LcpParams p;
+  p.cfl = 0;
+  p.substeps = substeps;
+  p.neighbour_skin = k == 0 ? 0.0 : 0.15;
+  return p;
+}
+
+void expect_same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) ASSERT_TRUE(a[i] == b[i]) << i;
+}
+}  // namespace
+
 TEST(LcpVerlet, SortAndMirrorPairsEveryEntryWithItsReverse) {
   Context ctx(2);
   Rng rng(11);
@@ -58,11 +82,7 @@ TEST(LcpVerlet, ACommonShiftOfTheHairKeepsTheLists) {
   std::vector<Vec3> out[2];
   std::size_t builds[2] = {0, 0};
   for (int k = 0; k < 2; ++k) {
-    LcpParams p;
-    p.cfl = 0;
-    p.substeps = 1;
-    p.neighbour_skin = k == 0 ? 0.0 : 0.15;
-    LcpSolver solver(p, sc.init.model, &sc.body);
+    LcpSolver solver(fixed_params(1, k), sc.init.model, &sc.body);
     LcpState s = solver.rest_state();
     LcpWorkspace ws;
     LcpStepInput in;
@@ -73,13 +93,10 @@ TEST(LcpVerlet, ACommonShiftOfTheHairKeepsTheLists) {
     for (std::size_t i = 0; i < s.x.size(); ++i)
       if (!solver.model().root[i]) s.x[i] += Vec3(shift, 0, 0);
     for (int f = 0; f < 3; ++f) ASSERT_TRUE(solver.step(ctx, in, s, ws).ok);
-    out[k] = s.x;
-    out[k].insert(out[k].end(), s.v.begin(), s.v.end());
-    out[k].insert(out[k].end(), s.t.begin(), s.t.end());
+    out[k] = state_vectors(s);
     builds[k] = ws.nbr_builds;
   }
-  ASSERT_EQ(out[0].size(), out[1].size());
-  for (std::size_t i = 0; i < out[0].size(); ++i) ASSERT_TRUE(out[0][i] == out[1][i]) << i;
+  expect_same_bits(out[0], out[1]);
   EXPECT_EQ(builds[0], 4u);  // every sub-step
   EXPECT_EQ(builds[1], 1u);  // the first one only
 }
@@ -108,14 +125,11 @@ TEST(LcpVerlet, SkinChangesNothingButTheRebuildCount) {
       ASSERT_TRUE(rep.ok) << rep.message;
       if (k == 0) substeps += rep.substeps;
     }
-    out[k] = s.x;
-    out[k].insert(out[k].end(), s.v.begin(), s.v.end());
-    out[k].insert(out[k].end(), s.t.begin(), s.t.end());
+    out[k] = state_vectors(s);
     builds[k] = ws.nbr_builds;
     if (k == 1) early = ws.nbr_early_builds;
   }
-  ASSERT_EQ(out[0].size(), out[1].size());
-  for (std::size_t i = 0; i < out[0].size(); ++i) ASSERT_TRUE(out[0][i] == out[1][i]) << i;
+  expect_same_bits(out[0], out[1]);
   EXPECT_EQ(builds[0], std::size_t(substeps));
   // Most rebuilds were decided from the displacements measured at the end of the sub-step
   // before (the first pass of the sub-step is then not run twice).
@@ -136,11 +150,7 @@ TEST(LcpVerlet, PositionsScatteredBetweenStepsRebuildTheLists) {
   auto sc = test::lcp_small_scene(ctx, 0.016);
   std::vector<Vec3> out[2];
   for (int k = 0; k < 2; ++k) {
-    LcpParams p;
-    p.cfl = 0;
-    p.substeps = 2;
-    p.neighbour_skin = k == 0 ? 0.0 : 0.15;
-    LcpSolver solver(p, sc.init.model, &sc.body);
+    LcpSolver solver(fixed_params(2, k), sc.init.model, &sc.body);
     LcpState s = solver.rest_state();
     LcpWorkspace ws;
     LcpStepInput in;
@@ -153,12 +163,9 @@ TEST(LcpVerlet, PositionsScatteredBetweenStepsRebuildTheLists) {
         if (!solver.model().root[i])
           s.x[i] += Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * 3 * skin;
     }
-    out[k] = s.x;
-    out[k].insert(out[k].end(), s.v.begin(), s.v.end());
-    out[k].insert(out[k].end(), s.t.begin(), s.t.end());
+    out[k] = state_vectors(s);
   }
-  ASSERT_EQ(out[0].size(), out[1].size());
-  for (std::size_t i = 0; i < out[0].size(); ++i) ASSERT_TRUE(out[0][i] == out[1][i]) << i;
+  expect_same_bits(out[0], out[1]);
 }
 
 TEST(LcpVerlet, ParallelGridBuildMatchesSerialBuild) {
@@ -185,10 +192,7 @@ TEST(LcpVerlet, PositionsEditedBetweenStepsAreNotServedFromTheCache) {
   // must get exactly what a fresh workspace gives.
   Context ctx(2);
   auto sc = test::lcp_small_scene(ctx, 0.016);
-  LcpParams p;
-  p.cfl = 0;
-  p.substeps = 2;
-  LcpSolver solver(p, sc.init.model, &sc.body);
+  LcpSolver solver(fixed_params(2, 1), sc.init.model, &sc.body);
   std::vector<Vec3> out[3];
   for (int k = 0; k < 3; ++k) {
     LcpState s = solver.rest_state();
@@ -203,12 +207,9 @@ TEST(LcpVerlet, PositionsEditedBetweenStepsAreNotServedFromTheCache) {
           if (!solver.model().root[i]) s.x[i].y() -= 2e-4 * double(1 + i % 3);
       if (k == 2) ws = LcpWorkspace{};
     }
-    out[k] = s.x;
-    out[k].insert(out[k].end(), s.v.begin(), s.v.end());
-    out[k].insert(out[k].end(), s.t.begin(), s.t.end());
+    out[k] = state_vectors(s);
   }
-  ASSERT_EQ(out[1].size(), out[2].size());
-  for (std::size_t i = 0; i < out[1].size(); ++i) ASSERT_TRUE(out[1][i] == out[2][i]) << i;
+  expect_same_bits(out[1], out[2]);
   bool moved = false;  // the edit had an effect
   for (std::size_t i = 0; i < out[0].size() && !moved; ++i) moved = !(out[0][i] == out[1][i]);
   EXPECT_TRUE(moved);
