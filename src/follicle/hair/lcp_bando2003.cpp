@@ -687,9 +687,21 @@ void LcpSolver::rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWor
   if (!sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
     fail("lcp: neighbour lists are not symmetric (internal error)");
   ws.nbr_built_x = s.x;
+  ws.nbr_shift = Vec3::Zero();  // displacements are measured from here
   ws.nbr_radius = R;
   ++ws.nbr_builds;
 }
+
+namespace {
+/// max |x_i - x_i(list build) - u|^2 over i0 <= i < i1 (0 for an empty range).
+double max_shift2(const LcpState& s, const LcpWorkspace& ws, const Vec3& u, std::size_t i0,
+                  std::size_t i1) {
+  double m = 0;
+  for (std::size_t i = i0; i < i1; ++i)
+    m = std::max(m, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
+  return m;
+}
+}  // namespace
 
 bool LcpSolver::lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& ws,
                            double lim) const {
@@ -724,12 +736,7 @@ bool LcpSolver::lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& 
   if (!u.allFinite()) return false;
   const double e2 = deterministic_reduce(
       ctx, n, 4096, 0.0,
-      [&](std::size_t i0, std::size_t i1) {
-        double m = 0;
-        for (std::size_t i = i0; i < i1; ++i)
-          m = std::max(m, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
-        return m;
-      },
+      [&](std::size_t i0, std::size_t i1) { return max_shift2(s, ws, u, i0, i1); },
       [](double a, double b) { return std::max(a, b); });
   if (!(e2 < lim2)) return false;
   ws.nbr_shift = u;
@@ -1086,17 +1093,14 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     }
     const bool checked = rebuild || ws.shift_ready;  // no displacement test in the pass
     ws.shift_ready = false;
-    if (rebuild) ws.nbr_shift = Vec3::Zero();
     for (int attempt = 0; attempt < 2; ++attempt) {
       const Vec3 u = ws.nbr_shift;
       parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
-        double c2 = 0;
-        for (std::size_t i = i0; i < i1; ++i) {
-          if (do_alpha) coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
-          if (hh && !checked) c2 = std::max(c2, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
-        }
+        if (do_alpha)
+          for (std::size_t i = i0; i < i1; ++i)
+            coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
+        if (hh && !checked) ws.chunk_shift[i0 / kChunk] = max_shift2(s, ws, u, i0, i1);
         if (hh) active_pairs_of(i0 / kChunk, s, ws, pc);
-        ws.chunk_shift[i0 / kChunk] = c2;
       });
       if (!hh || checked) break;
       if (lists_hold(ctx, s, ws, 0.49 * skin)) break;  // every pair within 2h is still listed
@@ -1105,7 +1109,6 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       rebuild_neighbours(ctx, s, ws);
       pair_index(ctx, ws);
       pair_scratch(ws);
-      ws.nbr_shift = Vec3::Zero();
     }
     // 2. alpha sums (3.13), density (3.1) and pressure.
     parallel_for(
@@ -1188,12 +1191,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
       detail::lcp_direction_sum(din, i0, i1, s.t.data());  // (3.15)
       LcpWorkspace::ChunkCheck c;
-      if (measure) {
-        double c2 = 0;
-        for (std::size_t i = i0; i < i1; ++i)
-          c2 = std::max(c2, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
-        ws.chunk_shift[i0 / kChunk] = c2;
-      }
+      if (measure) ws.chunk_shift[i0 / kChunk] = max_shift2(s, ws, u, i0, i1);
       for (std::size_t i = i0; i < i1; ++i) {
         const double sp = s.v[i].norm();
         const bool bad =

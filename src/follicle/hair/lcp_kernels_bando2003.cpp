@@ -202,21 +202,24 @@ void air_density(const AirInputs& in, std::size_t i0, std::size_t i1, double* rh
   }
 }
 
+namespace {
+// The pressure term (3.16) of entry e of particle i added to s (nothing for r <= 0):
+// -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) grad_i W, grad_i W = -W'(r) d/r.
+inline void add_air_pressure(const AirInputs& in, std::size_t i, uint32_t e, Vec3& s) {
+  const uint32_t j = in.nb[e];
+  const Vec3 d = in.x[j] - in.x[i];
+  const double r = d.norm();
+  if (r <= 0) return;
+  double w, dw;
+  in.kernel.w_dw(r, w, dw);
+  s += (in.mass * in.mass * (in.p_rho2[i] + in.p_rho2[j]) * dw / r) * d;
+}
+}  // namespace
+
 void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) {
-  const SphKernel& K = in.kernel;
   for (std::size_t i = i0; i < i1; ++i) {
     Vec3 s = Vec3::Zero();
-    const double pi = in.p_rho2[i];
-    for (uint32_t e = in.off[i]; e < in.off[i + 1]; ++e) {
-      const uint32_t j = in.nb[e];
-      const Vec3 d = in.x[j] - in.x[i];
-      const double r = d.norm();
-      if (r <= 0) continue;
-      double w, dw;
-      K.w_dw(r, w, dw);
-      // (3.16) -m_i m_j (P_i/rho_i^2 + P_j/rho_j^2) grad_i W, grad_i W = -W'(r) d/r
-      s += (in.mass * in.mass * (pi + in.p_rho2[j]) * dw / r) * d;
-    }
+    for (uint32_t e = in.off[i]; e < in.off[i + 1]; ++e) add_air_pressure(in, i, e, s);
     f[i] = s;
   }
 }
@@ -518,15 +521,7 @@ void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) 
         }
     }
     Vec3 s(sx, sy, sz);
-    for (; e < e1; ++e) {
-      const uint32_t j = in.nb[e];
-      const Vec3 d = in.x[j] - xi;
-      const double r = d.norm();
-      if (r <= 0) continue;
-      double w, dw;
-      in.kernel.w_dw(r, w, dw);
-      s += (mm * (pi + in.p_rho2[j]) * dw / r) * d;
-    }
+    for (; e < e1; ++e) add_air_pressure(in, i, e, s);
     f[i] = s;
   }
 }
