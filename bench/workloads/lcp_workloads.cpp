@@ -5,15 +5,20 @@
 //  - "lcp-frame": one 1/60 s animation frame of the same scene with the default adaptive
 //    sub-stepping (as many leapfrog sub-steps as the CFL rule needs): comparable to the paper's
 //    per-frame figure.
-//  - "lcp-wind": one coupled step of dt = 0.2 ms: the SPH air step (as many air sub-steps as its
-//    CFL rule needs, 1 at the default sizes) and one hair step with one leapfrog sub-step, for a
-//    block of hanging strands (100,000 hair particles) in 25,000 air particles, after one
-//    untimed step (allocation).
+//  - "lcp-wind": one coupled step of dt = the hair's stable sub-step (the adaptive rule of
+//    LcpParams::cfl at the rest state, ≈ 0.1 ms at the default sizes): the SPH air step (as many
+//    air sub-steps as its CFL rule needs, 1 at the default sizes) and one hair step with one
+//    leapfrog sub-step, for a block of hanging strands (100,000 hair particles) in 25,000 air
+//    particles, after one untimed step (allocation). A blow-up fails the benchmark. (Until the
+//    ninth session dt was a fixed 0.2 ms, twice the stable sub-step: the hair's speed grew
+//    without bound and the run blew up after ≈ 400 steps, so longer runs timed an exploding
+//    state with a list rebuild every step.)
 // Size "simd" (default 1): 0 runs the scalar hair-hair pair loop instead of the AVX2 batch
 // kernel (same results, ADR 0008), for A/B timing.
 #include <cmath>
 #include <memory>
 
+#include "follicle/core/error.hpp"
 #include "follicle/hair/lcp_bando2003.hpp"
 #include "follicle/hair/lcp_scenario_bando2003.hpp"
 #include "follicle/hair/sph_air_bando2003.hpp"
@@ -38,7 +43,7 @@ class LcpStepInstance : public WorkloadInstance {
     // Leave the rest state: 20 ms of falling in stable 0.2 ms sub-steps (a single 1 ms leapfrog
     // sub-step is beyond the CFL limit and blew the hair up, so the benchmark used to time an
     // exploded state with particles at up to 100 m/s).
-    for (int k = 0; k < 100; ++k) m_scene->step(ctx, 2e-4);
+    for (int k = 0; k < 100; ++k) check(m_scene->step(ctx, 2e-4));
     m_n = double(m_scene->state().x.size());
     m_scene->use_simd(s.at("simd") != 0);  // after the warm-up: the same state either way
   }
@@ -48,7 +53,10 @@ class LcpStepInstance : public WorkloadInstance {
     p.cfl = 0;
     return p;
   }
-  void run_once() override { m_scene->step(m_ctx, m_frame ? 1.0 / 60 : 1e-4); }
+  void run_once() override { check(m_scene->step(m_ctx, m_frame ? 1.0 / 60 : 1e-4)); }
+  static void check(const hair::LcpStepReport& r) {
+    if (!r.ok) fail("lcp: the benchmark's hair blew up: {}", r.message);
+  }
   double items_per_iter() const override { return m_n; }
   double particles() const { return m_n; }
 
@@ -99,18 +107,24 @@ class LcpWindInstance : public WorkloadInstance {
     m_air = std::make_unique<hair::SphAir>(ctx, ap);
     m_nh = double(x.size());
     m_na = double(m_air->size());
+    // The sub-step the adaptive rule (default cfl) takes at the rest state.
+    hair::LcpWorkspace probe;
+    m_dt = hair::LcpParams{}.cfl / m_solver->stiffness_rate(ctx, m_state, probe);
+    if (!(m_dt > 0) || !std::isfinite(m_dt)) fail("lcp-wind: no stable time step ({})", m_dt);
     // One untimed step: it allocates the workspaces and faults in their pages (≈ 0.3 s at the
     // default sizes), which every later step reuses; timing it added ≈ 6 ms to the mean step
     // of a 3 s run.
     run_once();
   }
   void run_once() override {
-    const double dt = 2e-4;
-    m_air->step(m_ctx, dt, m_state.x, m_state.v, m_solver->model().mass, &m_force);
+    const sim::StepReport ar =
+        m_air->step(m_ctx, m_dt, m_state.x, m_state.v, m_solver->model().mass, &m_force);
+    if (!ar.ok) fail("lcp-wind: the air blew up: {}", ar.message);
     hair::LcpStepInput in;
-    in.dt = dt;
+    in.dt = m_dt;
     in.external_force = &m_force;
-    m_solver->step(m_ctx, in, m_state, m_ws);
+    const hair::LcpStepReport hr = m_solver->step(m_ctx, in, m_state, m_ws);
+    if (!hr.ok) fail("lcp-wind: the hair blew up: {}", hr.message);
   }
   double items_per_iter() const override { return 1.0; }
 
@@ -122,6 +136,7 @@ class LcpWindInstance : public WorkloadInstance {
   std::unique_ptr<hair::SphAir> m_air;
   std::vector<Vec3> m_force;
   double m_nh = 0, m_na = 0;
+  double m_dt = 0;  // [s] one coupled step
 };
 
 }  // namespace
@@ -144,8 +159,8 @@ void add_lcp_workloads(std::vector<Workload>& out) {
          return std::make_unique<LcpStepInstance>(ctx, s, true);
        }});
   out.push_back({"lcp-wind",
-                 "LCP hair in SPH wind (Bando 2003 §3.6): one coupled step of 0.2 ms (air + 1 hair "
-                 "sub-step)",
+                 "LCP hair in SPH wind (Bando 2003 §3.6): one coupled step (air + 1 hair "
+                 "sub-step of the stable length, ≈ 0.1 ms)",
                  {{"hair", 100000}, {"air", 25000}, {"simd", 1}},
                  "steps/s",
                  [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {

@@ -659,6 +659,28 @@ void LcpSolver::solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace&
   alpha_sweeps(ctx, ws);
 }
 
+double LcpSolver::stiffness_rate(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const {
+  const auto& m = m_model;
+  solve_alpha(ctx, s, ws);
+  const double w2 = deterministic_reduce(
+      ctx, m.size(), 1024, 0.0,
+      [&](std::size_t i0, std::size_t i1) {
+        double w = 0;
+        for (std::size_t i = i0; i < i1; ++i) {
+          double ks = 0;
+          for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e)
+            ks += ws.alpha[m.adj_pairs[e]] * ws.k[m.adj_pairs[e]];
+          w = std::max(w, ks / m.mass[i]);
+        }
+        return w;
+      },
+      [](double a, double b) { return std::max(a, b); });
+  // The explicit hair-hair damping (3.17)/(3.18) needs d dt < 1 as well (per reduced mass).
+  const auto& P = m_params;
+  return std::max(std::sqrt(w2),
+                  P.hair_hair ? std::max(P.collision_damping, P.friction_damping) : 0.0);
+}
+
 void LcpSolver::tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
                                std::vector<double>& e_t) const {
   const auto& m = m_model;
@@ -682,7 +704,7 @@ void LcpSolver::rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWor
   // while 2 d_max < skin (rebuilt a little earlier to stay clear of rounding).
   const double h = m_model.h;
   const double R = 2 * h + m_params.neighbour_skin * 2 * h;
-  ws.grid.build(s.x, R);
+  ws.grid.build(ctx, s.x, R);
   ws.grid.neighbour_lists(ctx, s.x, R, ws.nbr_offsets, ws.nbrs);
   if (!sort_and_mirror(ctx, ws.nbr_offsets, ws.nbrs, ws.nbr_mirror))
     fail("lcp: neighbour lists are not symmetric (internal error)");
@@ -693,6 +715,17 @@ void LcpSolver::rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWor
 }
 
 namespace {
+/// Whether a and b hold the same bits (compared in parallel chunks).
+bool same_bits(const Context& ctx, const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  if (a.size() != b.size()) return false;
+  return deterministic_reduce(
+             ctx, a.size(), 16384, 1,
+             [&](std::size_t i0, std::size_t i1) {
+               return int(std::memcmp(a.data() + i0, b.data() + i0, (i1 - i0) * sizeof(Vec3)) == 0);
+             },
+             [](int x, int y) { return x & y; }) != 0;
+}
+
 /// max |x_i - x_i(list build) - u|^2 over i0 <= i < i1 (0 for an empty range).
 double max_shift2(const LcpState& s, const LcpWorkspace& ws, const Vec3& u, std::size_t i0,
                   std::size_t i1) {
@@ -1010,8 +1043,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   ws.p_rho2.resize(n);
   // Connection geometry: still valid when the positions are those it was computed from.
   const bool geom_valid = ws.geom_owner == this && ws.conn_r.size() == np &&
-                          ws.conn_xh.size() == np && ws.geom_x.size() == n &&
-                          std::memcmp(ws.geom_x.data(), s.x.data(), n * sizeof(Vec3)) == 0;
+                          ws.conn_xh.size() == np && same_bits(ctx, ws.geom_x, s.x);
   ws.conn_r.resize(np);
   ws.conn_xh.resize(np);
   ws.dir_term.resize(8 * np);
@@ -1025,24 +1057,8 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   int nsub = P.substeps;
   bool alpha_fresh = false;  // ws.k/ws.alpha already hold the values for the current positions
   if (P.cfl > 0) {
-    solve_alpha(ctx, s, ws);
+    const double rate = stiffness_rate(ctx, s, ws);
     alpha_fresh = true;
-    const double w2 = deterministic_reduce(
-        ctx, n, 1024, 0.0,
-        [&](std::size_t i0, std::size_t i1) {
-          double w = 0;
-          for (std::size_t i = i0; i < i1; ++i) {
-            double ks = 0;
-            for (uint32_t e = m.adj_offsets[i]; e < m.adj_offsets[i + 1]; ++e)
-              ks += ws.alpha[m.adj_pairs[e]] * ws.k[m.adj_pairs[e]];
-            w = std::max(w, ks / m.mass[i]);
-          }
-          return w;
-        },
-        [](double a, double b) { return std::max(a, b); });
-    // The explicit hair-hair damping (3.17)/(3.18) needs d dt < 1 as well (per reduced mass).
-    const double rate = std::max(
-        std::sqrt(w2), P.hair_hair ? std::max(P.collision_damping, P.friction_damping) : 0.0);
     const double need = std::ceil(in.dt * rate / P.cfl);
     if (std::isfinite(need)) nsub = std::max(nsub, int(std::min<double>(need, P.max_substeps)));
   }
@@ -1055,8 +1071,9 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
              al_h = Rt * hd.angular_acceleration, V_h = Rt * hd.velocity;
   const Vec3 piv = hd.pivot;
   ws.accel.resize(n);
-  ws.contact.assign(n, 0);
-  ws.penetration.assign(n, 0.0);
+  ws.contact.resize(n);  // every sub-step writes every particle's entry (step 4)
+  ws.penetration.resize(n);
+  ws.geom_x.resize(n);
   const std::size_t nchunks = (n + kChunk - 1) / kChunk;
   ws.chunk_shift.resize(nchunks);
   ws.chunk_check.resize(nchunks);
@@ -1188,6 +1205,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     // With the hair-hair lists: the displacement since their build, for the next sub-step's test.
     const bool measure = hh && ws.nbr_built_x.size() == n;
     const Vec3 u = ws.nbr_shift;
+    const bool last = sub + 1 == nsub;
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
       detail::lcp_direction_sum(din, i0, i1, s.t.data());  // (3.15)
       LcpWorkspace::ChunkCheck c;
@@ -1198,6 +1216,9 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
             !std::isfinite(sp) || !s.x[i].allFinite() || !s.t[i].allFinite() || sp > vlim;
         if (bad && c.bad == SIZE_MAX) c.bad = i;
         if (std::isfinite(sp)) c.vmax = std::max(c.vmax, sp);
+        c.contacts += ws.contact[i];
+        c.max_pen = std::max(c.max_pen, ws.penetration[i]);
+        if (last) ws.geom_x[i] = s.x[i];  // the positions the connection geometry is of
       }
       ws.chunk_check[i0 / kChunk] = c;
     });
@@ -1208,8 +1229,12 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
     for (const auto& part : ws.chunk_check) {
       chk.vmax = std::max(chk.vmax, part.vmax);
       if (chk.bad == SIZE_MAX) chk.bad = part.bad;
+      chk.contacts += part.contacts;
+      chk.max_pen = std::max(chk.max_pen, part.max_pen);
     }
     rep.max_speed = chk.vmax;
+    rep.num_contacts = chk.contacts;
+    rep.max_penetration = chk.max_pen;
     if (chk.bad != SIZE_MAX) {
       const double sp = s.v[chk.bad].norm();
       if (std::isfinite(sp) && s.x[chk.bad].allFinite() && s.t[chk.bad].allFinite())
@@ -1223,10 +1248,7 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
       return rep;
     }
   }
-  ws.geom_x = s.x;
-  ws.geom_owner = this;
-  rep.num_contacts = std::size_t(std::count(ws.contact.begin(), ws.contact.end(), uint8_t(1)));
-  for (double d : ws.penetration) rep.max_penetration = std::max(rep.max_penetration, d);
+  ws.geom_owner = this;  // geom_x was filled in the last sub-step's final pass
   return rep;
 }
 

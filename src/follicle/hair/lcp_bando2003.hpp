@@ -214,6 +214,8 @@ struct LcpWorkspace {
   struct ChunkCheck {
     double vmax = 0;
     std::size_t bad = SIZE_MAX;
+    std::size_t contacts = 0;  // particles in contact (last sub-step)
+    double max_pen = 0;        // deepest penetration [m] (last sub-step)
   };
   std::vector<ChunkCheck> chunk_check;
 };
@@ -263,6 +265,11 @@ class LcpSolver {
   // Pieces of a sub-step, public for tests and tools.
   /// k_ij (3.7) and the alpha solve (3.12)-(3.14) into ws.k / ws.alpha.
   void solve_alpha(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  /// The fastest rate [1/s] the adaptive sub-step rule limits at state s: the largest spring
+  /// frequency omega_i = sqrt(sum_j alpha_ij k_ij / m_i) and, with hair-hair interaction, the
+  /// explicit damping rates of (3.17)/(3.18). A sub-step dt is within the rule when
+  /// rate dt <= cfl. Runs solve_alpha (fills ws.k / ws.alpha).
+  double stiffness_rate(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
   /// E_{r,i} and E_{t,i} of (3.10)/(3.11) from ws.k/ws.alpha (0 where the group is empty).
   void tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
                       std::vector<double>& e_t) const;

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "follicle/core/error.hpp"
 #include "follicle/core/rng.hpp"
 #include "follicle/hair/sph_kernel.hpp"
@@ -387,4 +390,55 @@ TEST(LcpStep, IdenticalForOneAndTwoThreads) {
   }
   ASSERT_EQ(out[0].size(), out[1].size());
   for (std::size_t i = 0; i < out[0].size(); ++i) ASSERT_TRUE(out[0][i] == out[1][i]) << i;
+}
+
+TEST(LcpStep, StiffnessRateScalesAsTheRootOfTheModulusAndSetsTheSubSteps) {
+  Context ctx(2);
+  auto sc = test::lcp_small_scene(ctx);
+  LcpParams p;
+  p.hair_hair = false;  // springs only: rate = max_i sqrt(sum_j alpha_ij k_ij / m_i)
+  LcpWorkspace ws;
+  const LcpSolver soft(p, sc.init.model, &sc.body);
+  const double r1 = soft.stiffness_rate(ctx, soft.rest_state(), ws);
+  p.elastic_modulus *= 4;  // alpha (3.13) scales with E, so omega with sqrt(E)
+  const LcpSolver stiff(p, sc.init.model, &sc.body);
+  const double r4 = stiff.stiffness_rate(ctx, stiff.rest_state(), ws);
+  ASSERT_GT(r1, 0);
+  EXPECT_NEAR(r4 / r1, 2.0, 1e-9);
+  // The adaptive step takes ceil(dt rate / cfl) sub-steps.
+  LcpState s = stiff.rest_state();
+  LcpStepInput in;
+  in.dt = 7.3 / r4;
+  const LcpStepReport rep = stiff.step(ctx, in, s, ws);
+  ASSERT_TRUE(rep.ok) << rep.message;
+  EXPECT_EQ(rep.substeps, int(std::ceil(in.dt * r4 / p.cfl)));
+  // With hair-hair interaction its explicit damping rate is a floor.
+  p = LcpParams{};
+  p.collision_damping = 10 * r1;
+  const LcpSolver damped(p, sc.init.model, &sc.body);
+  EXPECT_DOUBLE_EQ(damped.stiffness_rate(ctx, damped.rest_state(), ws), 10 * r1);
+}
+
+TEST(LcpStep, ReportCountsTheContactsAndTheDeepestPenetration) {
+  Context ctx(2);
+  auto sc = test::lcp_small_scene(ctx);
+  LcpParams p;
+  LcpSolver solver(p, sc.init.model, &sc.body);
+  LcpState s = solver.rest_state();
+  LcpWorkspace ws;
+  LcpStepInput in;
+  in.dt = 1.0 / 120;
+  std::size_t seen = 0;
+  for (int k = 0; k < 12; ++k) {
+    in.head =
+        anim::RigidMotionTrack::shake(Vec3::Zero(), Vec3::UnitY(), 0.8, 2, 0, 1).sample(k * in.dt);
+    const LcpStepReport rep = solver.step(ctx, in, s, ws);
+    ASSERT_TRUE(rep.ok) << rep.message;
+    const auto contacts = std::size_t(std::count(ws.contact.begin(), ws.contact.end(), 1));
+    const double deepest = *std::max_element(ws.penetration.begin(), ws.penetration.end());
+    EXPECT_EQ(rep.num_contacts, contacts) << k;
+    EXPECT_EQ(rep.max_penetration, deepest) << k;
+    seen += contacts;
+  }
+  EXPECT_GT(seen, 0u);  // the shake presses hair onto the head
 }
