@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "follicle/core/cpu.hpp"
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define FOLLICLE_LCP_KERNELS_HAVE_AVX2 1
@@ -532,7 +534,7 @@ void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) 
 
 LcpKernels lcp_kernels(bool allow_simd) {
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
-  if (allow_simd && __builtin_cpu_supports("avx2"))
+  if (allow_simd && cpu_has_avx2())
     return {&avx2::active,         &avx2::batch,       &avx2::springs,      &avx2::geometry,
             &avx2::geometry_terms, &avx2::air_density, &avx2::air_pressure, true};
 #endif

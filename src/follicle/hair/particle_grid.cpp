@@ -5,6 +5,7 @@
 #include <immintrin.h>
 #endif
 
+#include "follicle/core/cpu.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
 
@@ -300,8 +301,7 @@ uint32_t filter_avx2(const detail::CellTable& g, const Range* rg, std::size_t nr
 
 bool have_avx2() {
 #ifdef FOLLICLE_GRID_AVX2
-  static const bool yes = __builtin_cpu_supports("avx2");
-  return yes;
+  return cpu_has_avx2();
 #else
   return false;
 #endif

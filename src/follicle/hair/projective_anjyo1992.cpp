@@ -10,6 +10,7 @@
 #include <immintrin.h>
 #endif
 
+#include "follicle/core/cpu.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
 #include "follicle/core/params.hpp"
@@ -206,7 +207,7 @@ using BlockFn = void (*)(const StepArgs&, std::size_t, std::size_t, sim::StepRep
 // AVX2 when the CPU has it (same results, twice the lanes), else SSE2.
 BlockFn pick_block_kernel() {
 #ifdef FOLLICLE_PROJECTIVE_HAVE_AVX2
-  if (__builtin_cpu_supports("avx2")) return &avx2::step_block;
+  if (cpu_has_avx2()) return &avx2::step_block;
 #endif
   return &sse2::step_block;
 }

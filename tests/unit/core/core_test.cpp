@@ -3,9 +3,12 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <string>
 
 #include "follicle/core/atomic_file.hpp"
 #include "follicle/core/context.hpp"
+#include "follicle/core/cpu.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
 #include "follicle/core/params.hpp"
@@ -158,4 +161,22 @@ TEST(AtomicFile, WritesWholeFileOrNothing) {
   for (auto& e : std::filesystem::directory_iterator(dir))
     EXPECT_EQ(e.path().filename(), "a.txt") << "temp file left behind";
   EXPECT_THROW(read_file(dir / "missing.txt"), Error);
+}
+
+TEST(Cpu, Avx2CheckAgreesWithTheKernelsCpuFlags) {
+  const bool a = follicle::cpu_has_avx2();
+  EXPECT_EQ(a, follicle::cpu_has_avx2());  // evaluated once, stable
+  // On Linux the kernel lists the CPU's features in /proc/cpuinfo ("flags : ... avx2 ...").
+  std::ifstream in("/proc/cpuinfo");
+  if (!in) GTEST_SKIP() << "no /proc/cpuinfo";
+  std::string line;
+  bool listed = false, found = false;
+  while (std::getline(in, line) && !found) {
+    if (line.rfind("flags", 0) != 0) continue;
+    found = true;
+    std::istringstream words(line.substr(line.find(':') + 1));
+    for (std::string w; words >> w;) listed |= w == "avx2";
+  }
+  if (!found) GTEST_SKIP() << "no flags line (not x86)";
+  EXPECT_EQ(a, listed);
 }
