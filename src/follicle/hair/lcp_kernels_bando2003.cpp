@@ -226,6 +226,20 @@ void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) 
   }
 }
 
+namespace {
+// Mirrored operation for operation by avx2::air_drag (LcpKernels.AirDragKernelGivesTheScalarBits).
+inline Vec3 air_drag_entry(const AirDragInputs& in, std::size_t i, uint32_t e) {
+  const uint32_t h = in.nb[e];
+  const double r = (in.x[i] - in.hair_x[h]).norm();
+  return in.drag * in.mu[h] * (in.kernel.w(r) * in.inv_w0) * (in.v[i] - in.hair_v[h]);
+}
+}  // namespace
+
+void air_drag(const AirDragInputs& in, std::size_t i0, std::size_t i1, Vec3* f) {
+  for (std::size_t i = i0; i < i1; ++i)
+    for (uint32_t e = in.off[i]; e < in.off[i + 1]; ++e) f[e] = air_drag_entry(in, i, e);
+}
+
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
 #pragma GCC push_options
 // AVX2 without FMA: no contraction, so each lane rounds exactly as the scalar code.
@@ -528,6 +542,30 @@ void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) 
   }
 }
 
+void air_drag(const AirDragInputs& in, std::size_t i0, std::size_t i1, Vec3* f) {
+  const V zero = splat(0.0), one = splat(1.0), two = splat(2.0), four = splat(4.0);
+  const V inv_h = splat(in.kernel.inv_h), sw = splat(in.kernel.sigma_w * 0.25);
+  const V inv_w0 = splat(in.inv_w0), d = splat(in.drag);
+  for (std::size_t i = i0; i < i1; ++i) {
+    const Vec3 xa = in.x[i], va = in.v[i];
+    uint32_t e = in.off[i];
+    const uint32_t e1 = in.off[i + 1];
+    for (; e + 4 <= e1; e += 4) {
+      const V3 xh = load3(in.hair_x, in.nb + e), vh = load3(in.hair_v, in.nb + e);
+      const V dx = splat(xa.x()) - xh.x, dy = splat(xa.y()) - xh.y, dz = splat(xa.z()) - xh.z;
+      const V q = vsqrt(dx * dx + dy * dy + dz * dz) * inv_h;
+      V a = two - q, b = one - q;
+      a = a < zero ? zero : a;  // std::max(., 0.0)
+      b = b < zero ? zero : b;
+      const V w = sw * (a * a * a - four * b * b * b);  // SphKernel::w
+      const V c = d * load1(in.mu, in.nb + e) * (w * inv_w0);
+      store3(f + e, V3{c * (splat(va.x()) - vh.x), c * (splat(va.y()) - vh.y),
+                       c * (splat(va.z()) - vh.z)});
+    }
+    for (; e < e1; ++e) f[e] = air_drag_entry(in, i, e);
+  }
+}
+
 }  // namespace avx2
 #pragma GCC pop_options
 #endif
@@ -535,12 +573,13 @@ void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f) 
 LcpKernels lcp_kernels(bool allow_simd) {
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
   if (allow_simd && cpu_has_avx2())
-    return {&avx2::active,         &avx2::batch,       &avx2::springs,      &avx2::geometry,
-            &avx2::geometry_terms, &avx2::air_density, &avx2::air_pressure, true};
+    return {&avx2::active,       &avx2::batch,          &avx2::springs,
+            &avx2::geometry,     &avx2::geometry_terms, &avx2::air_density,
+            &avx2::air_pressure, &avx2::air_drag,       true};
 #endif
   (void)allow_simd;
-  return {&active_scalar,      &batch_scalar, &lcp_springs,  &lcp_geometry,
-          &lcp_geometry_terms, &air_density,  &air_pressure, false};
+  return {&active_scalar, &batch_scalar, &lcp_springs, &lcp_geometry, &lcp_geometry_terms,
+          &air_density,   &air_pressure, &air_drag,    false};
 }
 
 }  // namespace follicle::hair::detail

@@ -161,6 +161,22 @@ void air_pressure(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f);
 using AirDensityFn = void (*)(const AirInputs& in, std::size_t i0, std::size_t i1, double* rho);
 using AirPressureFn = void (*)(const AirInputs& in, std::size_t i0, std::size_t i1, Vec3* f);
 
+/// Air-hair drag (§3.6, two-way coupling): air particle i (position x, velocity v) with the hair
+/// particles listed for it (CSR: entries off[i] .. off[i + 1] - 1 of nb, hair indices).
+struct AirDragInputs {
+  const Vec3 *x = nullptr, *v = nullptr;            // air
+  const Vec3 *hair_x = nullptr, *hair_v = nullptr;  // hair
+  const double* mu = nullptr;  // reduced mass m_h m_a / (m_h + m_a) per hair particle
+  const uint32_t *off = nullptr, *nb = nullptr;
+  double drag = 0;        // d [1/s]
+  SphKernel kernel{1.0};  // W_c, zero beyond the coupling radius
+  double inv_w0 = 0;      // 1 / W_c(0)
+};
+/// The drag on the hair particle of each entry e, f[e] = d mu_h (W_c(r) / W_c(0)) (v_a - v_h),
+/// r = |x_a - x_h|, for the entries of air particles i0 <= i < i1 (the air particle gets -f[e]).
+void air_drag(const AirDragInputs& in, std::size_t i0, std::size_t i1, Vec3* f);
+using AirDragFn = void (*)(const AirDragInputs& in, std::size_t i0, std::size_t i1, Vec3* f);
+
 struct LcpKernels {
   ActivePairsFn active = nullptr;
   HairPairBatchFn forces = nullptr;
@@ -169,6 +185,7 @@ struct LcpKernels {
   GeometryTermsFn geometry_terms = nullptr;
   AirDensityFn air_density = nullptr;
   AirPressureFn air_pressure = nullptr;
+  AirDragFn air_drag = nullptr;
   bool simd = false;  // the AVX2 kernels
 };
 

@@ -93,6 +93,15 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
                              std::vector<Vec3>* force_on_hair) {
   sim::StepReport rep;
   const std::size_t nh = hair_x.size();
+  struct Check {
+    std::size_t bad = SIZE_MAX;  // first non-finite or too fast particle
+    bool non_finite = false;     // some particle is NaN/Inf
+    double vmax = 0;             // fastest finite speed
+    bool outside = false;        // some particle left the box
+  };
+  auto outside = [&](const Vec3& x) {
+    return (x.array() < m_p.box_min.array()).any() || (x.array() > m_p.box_max.array()).any();
+  };
   if (hair_v.size() != nh || hair_mass.size() != nh || !(dt > 0) || !std::isfinite(dt)) {
     rep.ok = false;
     rep.message = "sph_air: hair arrays differ in size or dt is not > 0";
@@ -105,19 +114,28 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
   const double inv_wc0 = 1.0 / Kc.w(0.0);
   std::vector<Vec3>& impulse = m_impulse;
   impulse.resize(nh);
-  parallel_for(
-      ctx, 0, nh, [&](std::size_t i) { impulse[i] = Vec3::Zero(); }, 4096);
-  if (nh) m_hair_grid.build(ctx, hair_x, rc);
   m_mu.resize(nh);  // reduced mass of each hair particle with an air particle
   parallel_for(
-      ctx, 0, nh, [&](std::size_t i) { m_mu[i] = hair_mass[i] * m_mass / (hair_mass[i] + m_mass); },
+      ctx, 0, nh,
+      [&](std::size_t i) {
+        impulse[i] = Vec3::Zero();
+        m_mu[i] = hair_mass[i] * m_mass / (hair_mass[i] + m_mass);
+      },
       4096);
+  if (nh) m_hair_grid.build(ctx, hair_x, rc);
+  auto max_of = [](double a, double b) { return std::max(a, b); };
   double t = 0;
   int guard = 0;
   while (t < dt - 1e-12 && guard++ < 100000) {
     const std::size_t n = m_x.size();
-    double vmax = 0;
-    for (const auto& v : m_v) vmax = std::max(vmax, v.norm());
+    const double vmax = deterministic_reduce(
+        ctx, n, kAirChunk, 0.0,
+        [&](std::size_t i0, std::size_t i1) {
+          double m = 0;
+          for (std::size_t i = i0; i < i1; ++i) m = std::max(m, m_v[i].norm());
+          return m;
+        },
+        max_of);
     double sub = m_p.cfl * h / (cs + vmax + 1e-9);
     if (m_p.drag > 0 && nh) sub = std::min(sub, m_p.cfl / m_p.drag);
     sub = std::min(sub, dt - t);
@@ -143,10 +161,6 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
         m_pr_rho2[i] = m_pr[i] / (rho * rho);  // P/rho^2 of (3.16), once per particle
       }
     });
-    auto drag_on_hair = [&](std::size_t hi, std::size_t ai) -> Vec3 {
-      const double r = (m_x[ai] - hair_x[hi]).norm();
-      return m_p.drag * m_mu[hi] * (Kc.w(r) * inv_wc0) * (m_v[ai] - hair_v[hi]);
-    };
     // Air-hair pairs: lists from each air particle to the hair within rc; the drag of each pair
     // is evaluated once (force on the hair particle, the air particle gets the negation) and
     // summed per hair particle in entry order, i.e. air-index order (deterministic; equal and
@@ -155,8 +169,19 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
     if (nh) {
       m_hair_grid.cross_lists(ctx, m_x, hair_x, rc, m_aoff, m_anb);  // air -> hair
       m_drag.resize(m_anb.size());
-      parallel_for(ctx, 0, n, [&](std::size_t i) {
-        for (uint32_t e = m_aoff[i]; e < m_aoff[i + 1]; ++e) m_drag[e] = drag_on_hair(m_anb[e], i);
+      detail::AirDragInputs din;
+      din.x = m_x.data();
+      din.v = m_v.data();
+      din.hair_x = hair_x.data();
+      din.hair_v = hair_v.data();
+      din.mu = m_mu.data();
+      din.off = m_aoff.data();
+      din.nb = m_anb.data();
+      din.drag = m_p.drag;
+      din.kernel = Kc;
+      din.inv_w0 = inv_wc0;
+      parallel_chunks(ctx, n, kAirChunk, [&](std::size_t i0, std::size_t i1) {
+        m_kernels.air_drag(din, i0, i1, m_drag.data());
       });
       m_hair_sum.resize(nh);
       parallel_for(
@@ -181,31 +206,52 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
       m_x[i] += m_v[i] * sub;
     });
     t += sub;
-    // Remove particles that left the box (order kept: deterministic), then feed the inflow.
-    std::size_t k = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const bool bad = !m_x[i].allFinite() || !m_v[i].allFinite() || m_v[i].norm() > m_p.max_speed;
-      if (bad) {
-        if (m_v[i].allFinite() && m_x[i].allFinite())
-          rep.mark_blow_up(i);
-        else
-          rep.mark_non_finite(i);
-      }
-      rep.max_speed = std::max(rep.max_speed, std::isfinite(m_v[i].norm()) ? m_v[i].norm() : 0.0);
-      if ((m_x[i].array() < m_p.box_min.array()).any() ||
-          (m_x[i].array() > m_p.box_max.array()).any())
-        continue;
-      m_x[k] = m_x[i];
-      m_v[k] = m_v[i];
-      ++k;
-    }
-    if (!rep.ok) {
+    // Blow-up check (first bad particle in index order), the fastest speed and whether any
+    // particle left the box: per chunk in parallel, combined in chunk order.
+    const Check chk = deterministic_reduce(
+        ctx, n, kAirChunk, Check{},
+        [&](std::size_t i0, std::size_t i1) {
+          Check c;
+          for (std::size_t i = i0; i < i1; ++i) {
+            const double sp = m_v[i].norm();
+            const bool bad = !m_x[i].allFinite() || !m_v[i].allFinite() || sp > m_p.max_speed;
+            if (bad && c.bad == SIZE_MAX) c.bad = i;
+            c.non_finite |= bad && !(m_x[i].allFinite() && m_v[i].allFinite());
+            if (std::isfinite(sp)) c.vmax = std::max(c.vmax, sp);
+            c.outside |= outside(m_x[i]);
+          }
+          return c;
+        },
+        [](Check a, const Check& b) {
+          if (a.bad == SIZE_MAX) a.bad = b.bad;
+          a.non_finite |= b.non_finite;
+          a.vmax = std::max(a.vmax, b.vmax);
+          a.outside |= b.outside;
+          return a;
+        });
+    rep.max_speed = std::max(rep.max_speed, chk.vmax);
+    if (chk.bad != SIZE_MAX) {
+      // As marking every bad particle: the first index; NaN/Inf named when any particle is.
+      if (chk.non_finite)
+        rep.mark_non_finite(chk.bad);
+      else
+        rep.mark_blow_up(chk.bad);
       if (force_on_hair) force_on_hair->assign(nh, Vec3::Zero());
       rep.finish("sph_air", m_p.max_speed);
       return rep;
     }
-    m_x.resize(k);
-    m_v.resize(k);
+    // Remove particles that left the box (order kept: deterministic), then feed the inflow.
+    if (chk.outside) {
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (outside(m_x[i])) continue;
+        m_x[k] = m_x[i];
+        m_v[k] = m_v[i];
+        ++k;
+      }
+      m_x.resize(k);
+      m_v.resize(k);
+    }
     m_phase += std::abs(m_p.wind_velocity[m_axis]) * sub;
     while (m_phase >= m_p.spacing) {
       m_phase -= m_p.spacing;

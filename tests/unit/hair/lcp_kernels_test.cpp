@@ -628,3 +628,62 @@ TEST(LcpKernels, AirDensityAndPressureGiveTheScalarBits) {
   EXPECT_LT((f_s[3] - f).norm(), 1e-12 * (1 + f.norm()));
   if (!fast.simd) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar loops were compared";
 }
+
+TEST(LcpKernels, AirDragKernelGivesTheScalarBits) {
+  // The air-hair drag (§3.6): air particles with lists of random lengths (tails of 0-3 after the
+  // blocks of four) of hair particles on both kernel pieces, beyond the coupling radius (no
+  // drag) and coincident with the air particle (full drag).
+  const double rc = 0.01;  // coupling radius 2 h_c
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const std::size_t na = 200, nh = 300;
+  std::vector<Vec3> xa(na), va(na), xh(nh), vh(nh);
+  std::vector<double> mu(nh);
+  for (auto& p : xa) p = Vec3(u(rng), u(rng), u(rng)) * 1.2 * rc;
+  for (auto& p : va) p = Vec3(3 + u(rng), u(rng), u(rng));
+  for (auto& p : xh) p = Vec3(u(rng), u(rng), u(rng)) * 1.2 * rc;
+  for (auto& p : vh) p = Vec3(u(rng), u(rng), u(rng));
+  for (auto& m : mu) m = 1e-6 * (1.5 + u(rng));
+  xh[11] = xa[5];
+  std::vector<uint32_t> off{0}, nb;
+  for (std::size_t i = 0; i < na; ++i) {
+    const std::size_t len = rng() % 19;
+    for (std::size_t k = 0; k < len; ++k) nb.push_back(uint32_t(rng() % nh));
+    if (i == 5) nb.push_back(11);
+    off.push_back(uint32_t(nb.size()));
+  }
+  const SphKernel Kc(rc / 2);
+  detail::AirDragInputs in;
+  in.x = xa.data();
+  in.v = va.data();
+  in.hair_x = xh.data();
+  in.hair_v = vh.data();
+  in.mu = mu.data();
+  in.off = off.data();
+  in.nb = nb.data();
+  in.drag = 150;
+  in.kernel = Kc;
+  in.inv_w0 = 1.0 / Kc.w(0.0);
+  const auto scalar = detail::lcp_kernels(false), fast = detail::lcp_kernels(true);
+  std::vector<Vec3> f_s(nb.size()), f_f(nb.size());
+  scalar.air_drag(in, 0, na, f_s.data());
+  fast.air_drag(in, 0, na, f_f.data());
+  std::size_t beyond = 0;
+  for (std::size_t i = 0; i < na; ++i)
+    for (uint32_t e = off[i]; e < off[i + 1]; ++e) {
+      ASSERT_TRUE(same_bits(f_s[e], f_f[e])) << i << " " << e;
+      // Against the definition with Monaghan's piecewise kernel.
+      const double r = (xa[i] - xh[nb[e]]).norm();
+      const Vec3 f =
+          in.drag * mu[nb[e]] * sph_w(rc / 2, r) / sph_w(rc / 2, 0.0) * (va[i] - vh[nb[e]]);
+      ASSERT_LT((f_s[e] - f).norm(), 1e-12 * (1e-9 + f.norm())) << e;
+      if (r >= rc) {
+        ASSERT_EQ(f_s[e], Vec3::Zero()) << e;
+        ++beyond;
+      }
+    }
+  EXPECT_GT(beyond, 0u);           // the case was exercised
+  const uint32_t e5 = off[6] - 1;  // coincident: the full drag d mu (v_a - v_h)
+  EXPECT_LT((f_s[e5] - in.drag * mu[11] * (va[5] - vh[11])).norm(), 1e-12);
+  if (!fast.simd) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar loops were compared";
+}
