@@ -88,6 +88,20 @@ Vec3 SphAir::momentum() const {
   return p;
 }
 
+double SphAir::stable_step(const Context& ctx, bool coupled) const {
+  const double vmax = deterministic_reduce(
+      ctx, m_x.size(), kAirChunk, 0.0,
+      [&](std::size_t i0, std::size_t i1) {
+        double m = 0;
+        for (std::size_t i = i0; i < i1; ++i) m = std::max(m, m_v[i].norm());
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
+  double sub = m_p.cfl * m_h / (std::sqrt(m_p.k_p) + vmax + 1e-9);
+  if (m_p.drag > 0 && coupled) sub = std::min(sub, m_p.cfl / m_p.drag);
+  return sub;
+}
+
 sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Vec3>& hair_x,
                              const std::vector<Vec3>& hair_v, const std::vector<double>& hair_mass,
                              std::vector<Vec3>* force_on_hair) {
@@ -109,7 +123,7 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
   }
   if (force_on_hair) force_on_hair->resize(nh);
   const double rc = m_p.coupling_radius;
-  const double h = m_h, cs = std::sqrt(m_p.k_p);
+  const double h = m_h;
   const SphKernel K(h), Kc(rc / 2);  // air-air; air-hair coupling (zero beyond rc)
   const double inv_wc0 = 1.0 / Kc.w(0.0);
   std::vector<Vec3>& impulse = m_impulse;
@@ -123,22 +137,11 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
       },
       4096);
   if (nh) m_hair_grid.build(ctx, hair_x, rc);
-  auto max_of = [](double a, double b) { return std::max(a, b); };
   double t = 0;
   int guard = 0;
   while (t < dt - 1e-12 && guard++ < 100000) {
     const std::size_t n = m_x.size();
-    const double vmax = deterministic_reduce(
-        ctx, n, kAirChunk, 0.0,
-        [&](std::size_t i0, std::size_t i1) {
-          double m = 0;
-          for (std::size_t i = i0; i < i1; ++i) m = std::max(m, m_v[i].norm());
-          return m;
-        },
-        max_of);
-    double sub = m_p.cfl * h / (cs + vmax + 1e-9);
-    if (m_p.drag > 0 && nh) sub = std::min(sub, m_p.cfl / m_p.drag);
-    sub = std::min(sub, dt - t);
+    const double sub = std::min(stable_step(ctx, nh > 0), dt - t);
     // Air-air: density (3.1) and pressure (no tension).
     const double cell = std::max(2 * h, rc);
     m_grid.build(ctx, m_x, cell);

@@ -69,6 +69,10 @@ class SphAir {
                        const std::vector<Vec3>& hair_v, const std::vector<double>& hair_mass,
                        std::vector<Vec3>* force_on_hair);
 
+  /// The longest stable air sub-step at the current velocities, the rule step() sub-steps by:
+  /// cfl h / (sqrt(k_p) + |v|max), and with hair (coupled) also cfl / drag.
+  double stable_step(const Context& ctx, bool coupled) const;
+
   const std::vector<Vec3>& positions() const { return m_x; }
   const std::vector<Vec3>& velocities() const { return m_v; }
   std::size_t size() const { return m_x.size(); }

@@ -282,3 +282,69 @@ TEST(LcpPhysics, WindPushesHairAndHairSlowsWind) {
   EXPECT_LT(zw, zc - 0.005);         // pushed downwind (-z)
   EXPECT_LT(v_hair, 0.97 * v_free);  // the hair slows the wind
 }
+
+TEST(LcpPhysics, AirAtItsOwnStableStepMovesTheHairAsTheTightCoupling) {
+  // Multi-rate coupling (as `follicle bench lcp-wind` and, coarser, the scenes run it): the SPH
+  // air advances at its own stable step (SphAir::stable_step, k hair sub-steps), its mean drag
+  // held over the next k hair sub-steps. Against an air step with every hair sub-step, the hair
+  // block is blown the same distance and the air slowed the same within a few per cent.
+  Context ctx(2);
+  const double a = 0.005;
+  const int len = 40, nx = 10, nz = 6;
+  std::vector<Vec3> x, t, uvs;
+  for (int k = 0; k < len; ++k)
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        x.push_back(Vec3(a * i, -a * k, a * j));
+        t.push_back(-Vec3::UnitY());
+        uvs.push_back(Vec3(double(i) / nx, double(j) / nz, a * (k - 1.5)));
+      }
+  LcpInitParams ip;
+  ip.spacing = a;
+  std::vector<double> mass(x.size(), 0.05 / 1e5);  // the lcp-wind block's particle mass
+  LcpParams p;
+  p.substeps = 1;
+  p.cfl = 0;
+  const LcpSolver solver(p, connect_particles(ctx, x, t, uvs, mass, ip));
+  SphAirParams ap;
+  ap.wind_velocity = Vec3(0, 0, -3);
+  ap.box_min = Vec3(-0.03, -a * len - 0.03, -0.06);
+  ap.box_max = Vec3(a * nx + 0.03, 0.03, a * nz + 0.06);
+  ap.spacing = 0.012;
+  ap.coupling_radius = 2 * a;
+  LcpState s0 = solver.rest_state();
+  LcpWorkspace probe;
+  const double dt = LcpParams{}.cfl / solver.stiffness_rate(ctx, s0, probe);
+  const int k = int(std::floor(SphAir(ctx, ap).stable_step(ctx, true) / dt));
+  ASSERT_GE(k, 4) << "the air's stable step should be several hair sub-steps";
+  Vec3 disp[2];
+  double air_vz[2];
+  for (int mode = 0; mode < 2; ++mode) {
+    const int every = mode == 0 ? 1 : k;
+    LcpState s = solver.rest_state();
+    LcpWorkspace ws;
+    SphAir air(ctx, ap);
+    std::vector<Vec3> f;
+    for (int step = 0; step < 40 * k; ++step) {
+      if (step % every == 0) {
+        const auto ar = air.step(ctx, every * dt, s.x, s.v, solver.model().mass, &f);
+        ASSERT_TRUE(ar.ok) << ar.message;
+      }
+      LcpStepInput in;
+      in.dt = dt;
+      in.external_force = &f;
+      const auto r = solver.step(ctx, in, s, ws);
+      ASSERT_TRUE(r.ok) << r.message;
+    }
+    disp[mode] = Vec3::Zero();
+    for (std::size_t i = 0; i < x.size(); ++i) disp[mode] += (s.x[i] - x[i]) / double(x.size());
+    air_vz[mode] = air.mean_velocity_in(ap.box_min, ap.box_max).z();
+  }
+  std::printf(
+      "k = %d: mean hair displacement z %.2f mm (tight) %.2f mm (multi-rate); air vz %.3f / "
+      "%.3f m/s\n",
+      k, 1e3 * disp[0].z(), 1e3 * disp[1].z(), air_vz[0], air_vz[1]);
+  EXPECT_LT(disp[0].z(), -0.002);  // blown downwind by millimetres
+  EXPECT_LT((disp[1] - disp[0]).norm(), 0.03 * disp[0].norm());
+  EXPECT_NEAR(air_vz[1], air_vz[0], 0.01 * std::abs(air_vz[0]));
+}
