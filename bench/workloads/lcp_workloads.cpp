@@ -33,6 +33,11 @@ namespace follicle::workloads {
 
 namespace {
 
+// A blow-up (or any failed step) fails the benchmark with the step report's message.
+void check(const sim::StepReport& r, const char* what) {
+  if (!r.ok) fail("{}: {}", what, r.message);
+}
+
 class LcpStepInstance : public WorkloadInstance {
  public:
   LcpStepInstance(const Context& ctx, const Sizes& s, bool frame = false)
@@ -48,7 +53,7 @@ class LcpStepInstance : public WorkloadInstance {
     // Leave the rest state: 20 ms of falling in stable 0.2 ms sub-steps (a single 1 ms leapfrog
     // sub-step is beyond the CFL limit and blew the hair up, so the benchmark used to time an
     // exploded state with particles at up to 100 m/s).
-    for (int k = 0; k < 100; ++k) check(m_scene->step(ctx, 2e-4));
+    for (int k = 0; k < 100; ++k) check(m_scene->step(ctx, 2e-4), kWhat);
     m_n = double(m_scene->state().x.size());
     m_scene->use_simd(s.at("simd") != 0);  // after the warm-up: the same state either way
   }
@@ -58,10 +63,8 @@ class LcpStepInstance : public WorkloadInstance {
     p.cfl = 0;
     return p;
   }
-  void run_once() override { check(m_scene->step(m_ctx, m_frame ? 1.0 / 60 : 1e-4)); }
-  static void check(const hair::LcpStepReport& r) {
-    if (!r.ok) fail("lcp: the benchmark's hair blew up: {}", r.message);
-  }
+  void run_once() override { check(m_scene->step(m_ctx, m_frame ? 1.0 / 60 : 1e-4), kWhat); }
+  static constexpr const char* kWhat = "lcp: the benchmark's hair blew up";
   double items_per_iter() const override { return m_n; }
   double particles() const { return m_n; }
 
@@ -134,15 +137,14 @@ class LcpWindInstance : public WorkloadInstance {
   }
   void run_once() override {
     if (m_step++ % m_every == 0) {
-      const sim::StepReport ar = m_air->step(m_ctx, m_every * m_dt, m_state.x, m_state.v,
-                                             m_solver->model().mass, &m_force);
-      if (!ar.ok) fail("lcp-wind: the air blew up: {}", ar.message);
+      check(m_air->step(m_ctx, m_every * m_dt, m_state.x, m_state.v, m_solver->model().mass,
+                        &m_force),
+            "lcp-wind: the air blew up");
     }
     hair::LcpStepInput in;
     in.dt = m_dt;
     in.external_force = &m_force;
-    const hair::LcpStepReport hr = m_solver->step(m_ctx, in, m_state, m_ws);
-    if (!hr.ok) fail("lcp-wind: the hair blew up: {}", hr.message);
+    check(m_solver->step(m_ctx, in, m_state, m_ws), "lcp-wind: the hair blew up");
   }
   double items_per_iter() const override { return 1.0; }
 

@@ -49,5 +49,17 @@ PY
 [ $? = 1 ] && [ "$(wc -l <"$TMP/err")" = 1 ] && grep -q 'lcp.dynamics.hair_hiar' "$TMP/err" \
   || { fail "bad key"; cat "$TMP/err"; }
 
+# lcp-wind at small sizes: the multi-rate (default) and the tight coupling both run; a
+# fractional air_every fails with a clear message and exit code 1.
+for every in 0 1; do
+  "$FOLLICLE" bench lcp-wind --size hair=2000 --size air=1500 --size air_every=$every \
+    --min-seconds 0 -q >"$TMP/wind" 2>"$TMP/err" || { fail "bench lcp-wind air_every=$every"; cat "$TMP/err"; }
+  grep -q '"workload":"lcp-wind"' "$TMP/wind" || fail "bench lcp-wind output"
+done
+"$FOLLICLE" bench lcp-wind --size hair=2000 --size air=1500 --size air_every=2.5 \
+  --min-seconds 0 >/dev/null 2>"$TMP/err"
+[ $? = 1 ] && grep -q 'air_every must be a whole number' "$TMP/err" \
+  || { fail "bad air_every"; cat "$TMP/err"; }
+
 [ $fails = 0 ] && echo "cli_lcp: all passed"
 exit $fails
