@@ -442,3 +442,38 @@ TEST(LcpStep, ReportCountsTheContactsAndTheDeepestPenetration) {
   }
   EXPECT_GT(seen, 0u);  // the shake presses hair onto the head
 }
+
+TEST(LcpDirections, RestDirectionsAreAFixedPointAndTheUpdateMatchesTheStep) {
+  // (3.15) at the rest state: every t_i^j is the rest direction (theta0 was measured there), so
+  // the update returns the rest directions. After a step, update_directions from the new
+  // positions and the old directions gives the step's own new directions, bit for bit.
+  Context ctx(2);
+  auto sc = test::lcp_small_scene(ctx);
+  LcpParams p;
+  p.substeps = 1;
+  p.cfl = 0;
+  const LcpSolver solver(p, sc.init.model, &sc.body);
+  LcpWorkspace ws;
+  LcpState s = solver.rest_state();
+  solver.stiffness_rate(ctx, s, ws);  // fills ws.k / ws.alpha
+  solver.update_directions(ctx, s, ws);
+  const auto& m = solver.model();
+  for (std::size_t i = 0; i < m.size(); ++i) ASSERT_LT((s.t[i] - m.rest_t[i]).norm(), 1e-9) << i;
+  // One sub-step of falling hair (directions change).
+  s = solver.rest_state();
+  const std::vector<Vec3> t0 = s.t;
+  LcpStepInput in;
+  in.dt = 2e-4;
+  for (int k = 0; k < 20; ++k) ASSERT_TRUE(solver.step(ctx, in, s, ws).ok);
+  const std::vector<Vec3> t_before = s.t;
+  ASSERT_TRUE(solver.step(ctx, in, s, ws).ok);
+  LcpState u = s;
+  u.t = t_before;
+  solver.update_directions(ctx, u, ws);
+  double moved = 0;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    ASSERT_EQ(u.t[i], s.t[i]) << i;
+    moved = std::max(moved, (s.t[i] - t0[i]).norm());
+  }
+  EXPECT_GT(moved, 1e-6);  // the directions did change over the steps
+}
