@@ -85,22 +85,16 @@ class LcpWindInstance : public WorkloadInstance {
     const int strands = std::max(1, int(std::lround(s.at("hair") / len)));
     const int nx = std::max(1, int(std::lround(std::sqrt(strands * 2.5)))),
               nz = std::max(1, strands / nx);
-    std::vector<Vec3> x, t, uvs;
-    for (int k = 0; k < len; ++k)
-      for (int j = 0; j < nz; ++j)
-        for (int i = 0; i < nx; ++i) {
-          x.push_back(Vec3(a * i, -a * k, a * j));
-          t.push_back(-Vec3::UnitY());
-          uvs.push_back(Vec3(double(i) / nx, double(j) / nz, a * (k - 1.5)));
-        }
+    const hair::LcpStrandBlock block = hair::lcp_strand_block(nx, nz, len, a);
+    const std::vector<Vec3>& x = block.x;
     hair::LcpInitParams ip;
     ip.spacing = a;
     std::vector<double> mass(x.size(), 0.05 / double(x.size()));
     hair::LcpParams p;
     p.substeps = 1;
     p.cfl = 0;
-    m_solver =
-        std::make_unique<hair::LcpSolver>(p, hair::connect_particles(ctx, x, t, uvs, mass, ip));
+    m_solver = std::make_unique<hair::LcpSolver>(
+        p, hair::connect_particles(ctx, block.x, block.t, block.uvs, mass, ip));
     m_solver->use_simd(s.at("simd") != 0);
     m_state = m_solver->rest_state();
     // Air box around the block, spacing chosen for the requested air particle count.

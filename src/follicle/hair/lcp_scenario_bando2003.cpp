@@ -49,6 +49,23 @@ geom::TriMesh lcp_box_mesh(const Vec3& centre, const Vec3& half_extents) {
   return m;
 }
 
+LcpStrandBlock lcp_strand_block(int nx, int nz, int len, double a) {
+  LcpStrandBlock b;
+  const std::size_t n =
+      std::size_t(std::max(nx, 0)) * std::size_t(std::max(nz, 0)) * std::size_t(std::max(len, 0));
+  b.x.reserve(n);
+  b.t.reserve(n);
+  b.uvs.reserve(n);
+  for (int k = 0; k < len; ++k)
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        b.x.push_back(Vec3(a * i, -a * k, a * j));
+        b.t.push_back(-Vec3::UnitY());
+        b.uvs.push_back(Vec3(double(i) / nx, double(j) / nz, a * (k - 1.5)));
+      }
+  return b;
+}
+
 LcpScenario::LcpScenario(const Context& ctx, const LcpScenarioParams& params, const LcpParams& lcp,
                          const geom::TriMesh* head_mesh, const image::ImageF* length_map)
     : m_p(params) {

@@ -164,4 +164,14 @@ geom::TriMesh lcp_sphere_mesh(double radius, int nlat = 24, int nlon = 48);
 /// An axis-aligned box mesh (outward normals), e.g. the torso of a mesh head.
 geom::TriMesh lcp_box_mesh(const Vec3& centre, const Vec3& half_extents);
 
+/// Particles of a block of nx x nz straight strands of len particles each, spacing a, hanging
+/// from y = 0 along -y (the `lcp-wind` benchmark's hair): particle (i, j, k), strand (i, j),
+/// k-th from the top, at index (k nz + j) nx + i, position a (i, -k, j), direction -y and pillar
+/// coordinates (i / nx, j / nz, a (k - 1.5)), so the top two of each strand are root particles
+/// (s < 0). Input for connect_particles.
+struct LcpStrandBlock {
+  std::vector<Vec3> x, t, uvs;
+};
+LcpStrandBlock lcp_strand_block(int nx, int nz, int len, double a);
+
 }  // namespace follicle::hair

@@ -291,21 +291,15 @@ TEST(LcpPhysics, AirAtItsOwnStableStepMovesTheHairAsTheTightCoupling) {
   Context ctx(2);
   const double a = 0.005;
   const int len = 40, nx = 10, nz = 6;
-  std::vector<Vec3> x, t, uvs;
-  for (int k = 0; k < len; ++k)
-    for (int j = 0; j < nz; ++j)
-      for (int i = 0; i < nx; ++i) {
-        x.push_back(Vec3(a * i, -a * k, a * j));
-        t.push_back(-Vec3::UnitY());
-        uvs.push_back(Vec3(double(i) / nx, double(j) / nz, a * (k - 1.5)));
-      }
+  const LcpStrandBlock block = lcp_strand_block(nx, nz, len, a);
+  const std::vector<Vec3>& x = block.x;
   LcpInitParams ip;
   ip.spacing = a;
   std::vector<double> mass(x.size(), 0.05 / 1e5);  // the lcp-wind block's particle mass
   LcpParams p;
   p.substeps = 1;
   p.cfl = 0;
-  const LcpSolver solver(p, connect_particles(ctx, x, t, uvs, mass, ip));
+  const LcpSolver solver(p, connect_particles(ctx, block.x, block.t, block.uvs, mass, ip));
   SphAirParams ap;
   ap.wind_velocity = Vec3(0, 0, -3);
   ap.box_min = Vec3(-0.03, -a * len - 0.03, -0.06);

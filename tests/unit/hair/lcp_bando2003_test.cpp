@@ -7,6 +7,7 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/rng.hpp"
+#include "follicle/hair/lcp_scenario_bando2003.hpp"
 #include "follicle/hair/sph_kernel.hpp"
 #include "lcp_test_scenes.hpp"
 
@@ -476,4 +477,27 @@ TEST(LcpDirections, RestDirectionsAreAFixedPointAndTheUpdateMatchesTheStep) {
     moved = std::max(moved, (s.t[i] - t0[i]).norm());
   }
   EXPECT_GT(moved, 1e-6);  // the directions did change over the steps
+}
+
+TEST(LcpInit, StrandBlockLayout) {
+  // lcp_strand_block: strand-major numbering, hanging along -y, the top two particles of each
+  // strand below the scalp (s < 0: roots).
+  const double a = 0.005;
+  const LcpStrandBlock b = lcp_strand_block(3, 2, 4, a);
+  ASSERT_EQ(b.x.size(), 24u);
+  ASSERT_EQ(b.t.size(), 24u);
+  ASSERT_EQ(b.uvs.size(), 24u);
+  int roots = 0;
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 3; ++i) {
+        const std::size_t q = std::size_t((k * 2 + j) * 3 + i);
+        EXPECT_EQ(b.x[q], Vec3(a * i, -a * k, a * j)) << q;
+        EXPECT_EQ(b.t[q], Vec3(0, -1, 0)) << q;
+        EXPECT_EQ(b.uvs[q].head<2>(), Vec2(i / 3.0, j / 2.0)) << q;
+        roots += b.uvs[q].z() < 0;
+        EXPECT_EQ(b.uvs[q].z() < 0, k < 2) << q;
+      }
+  EXPECT_EQ(roots, 12);
+  EXPECT_TRUE(lcp_strand_block(0, 2, 4, a).x.empty());
 }
