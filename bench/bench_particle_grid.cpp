@@ -8,6 +8,7 @@
 
 #include "follicle/core/context.hpp"
 #include "follicle/core/rng.hpp"
+#include "follicle/hair/lcp_scenario_bando2003.hpp"
 #include "follicle/hair/particle_grid.hpp"
 
 namespace {
@@ -17,17 +18,13 @@ using namespace follicle;
 constexpr double kSpacing = 0.005;
 constexpr double kRadius = 2 * 0.8 * kSpacing * (1 + 0.15);
 
-/// nx * nz strands of `len` particles (strand-major like the lcp-wind block), jittered by 10 %.
+/// nx * nz strands of `len` particles (the lcp-wind block, hair::lcp_strand_block), jittered by
+/// 10 %.
 std::vector<Vec3> lattice(int nx, int nz, int len, uint64_t seed) {
   Rng rng(seed);
-  std::vector<Vec3> x;
-  x.reserve(std::size_t(nx) * std::size_t(nz) * std::size_t(len));
-  for (int k = 0; k < len; ++k)
-    for (int j = 0; j < nz; ++j)
-      for (int i = 0; i < nx; ++i)
-        x.push_back(Vec3(kSpacing * i, -kSpacing * k, kSpacing * j) +
-                    0.1 * kSpacing *
-                        Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)));
+  std::vector<Vec3> x = hair::lcp_strand_block(nx, nz, len, kSpacing).x;
+  for (Vec3& p : x)
+    p += 0.1 * kSpacing * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
   return x;
 }
 

@@ -8,12 +8,12 @@
 //  - "lcp-wind": one hair step of dt = the hair's stable sub-step (the adaptive rule of
 //    LcpParams::cfl at the rest state, ≈ 0.12 ms at the default sizes; one leapfrog sub-step)
 //    for a block of hanging strands (100,000 hair particles) in SPH wind (25,000 air
-//    particles), two-way coupled. The air advances at its own stable step (SphAir::stable_step
-//    at the start, ≈ 1.1 ms, cut to a whole number k of hair steps, k ≈ 9 at the default sizes):
-//    every k-th iteration runs one air step of k dt, whose mean drag force the next k hair steps
-//    apply (multi-rate coupling; the scenes couple coarser still, once per scene step of
-//    1/(fps steps_per_frame) ≈ 21 ms). Size "air_every" sets k (1: an air step with every hair
-//    step, the tightest coupling; 0, the default: the air's stable step). After one untimed
+//    particles), two-way coupled by hair::LcpWindCoupling. The air advances at its own stable step
+//    (SphAir::stable_step at the start, ≈ 1.1 ms, cut to a whole number k of hair steps, k ≈ 9 at
+//    the default sizes): every k-th iteration runs one air step of k dt, whose mean drag force the
+//    next k hair steps apply (multi-rate coupling; the scenes couple coarser still, once per scene
+//    step of 1/(fps steps_per_frame) ≈ 21 ms). Size "air_every" sets k (1: an air step with every
+//    hair step, the tightest coupling; 0, the default: the air's stable step). After one untimed
 //    step (allocation). A blow-up fails the benchmark. (Until the ninth session dt was a fixed
 //    0.2 ms, twice the stable sub-step: the hair's speed grew without bound and the run blew up
 //    after ≈ 400 steps; until the tenth the air stepped with every hair step.)
@@ -86,10 +86,9 @@ class LcpWindInstance : public WorkloadInstance {
     const int nx = std::max(1, int(std::lround(std::sqrt(strands * 2.5)))),
               nz = std::max(1, strands / nx);
     const hair::LcpStrandBlock block = hair::lcp_strand_block(nx, nz, len, a);
-    const std::vector<Vec3>& x = block.x;
     hair::LcpInitParams ip;
     ip.spacing = a;
-    std::vector<double> mass(x.size(), 0.05 / double(x.size()));
+    std::vector<double> mass(block.x.size(), 0.05 / double(block.x.size()));
     hair::LcpParams p;
     p.substeps = 1;
     p.cfl = 0;
@@ -107,7 +106,7 @@ class LcpWindInstance : public WorkloadInstance {
     ap.coupling_radius = std::min(ap.spacing, 2 * a);
     ap.max_particles = int(2 * s.at("air")) + 1000;
     m_air = std::make_unique<hair::SphAir>(ctx, ap);
-    m_nh = double(x.size());
+    m_nh = double(block.x.size());
     m_na = double(m_air->size());
     // The sub-step the adaptive rule (default cfl) takes at the rest state.
     hair::LcpWorkspace probe;
@@ -118,27 +117,19 @@ class LcpWindInstance : public WorkloadInstance {
     if (!(every >= 0) || every > 1e6 || every != std::floor(every))
       fail("lcp-wind: air_every must be a whole number >= 0 (0: the air's stable step), got {}",
            every);
-    m_every =
-        every > 0 ? int(every) : std::max(1, int(std::floor(m_air->stable_step(ctx, true) / m_dt)));
+    m_coupling = hair::LcpWindCoupling(
+        every > 0 ? int(every) : hair::LcpWindCoupling::air_every(ctx, *m_air, m_dt));
     ctx.log().info(
         "lcp-wind: {} hair + {} air particles, hair step {:.4f} ms, an air step every {} "
         "hair steps",
-        x.size(), m_air->size(), 1e3 * m_dt, m_every);
+        block.x.size(), m_air->size(), 1e3 * m_dt, m_coupling.every());
     // One untimed step: it allocates the workspaces and faults in their pages (≈ 0.3 s at the
     // default sizes), which every later step reuses; timing it added ≈ 6 ms to the mean step
     // of a 3 s run.
     run_once();
   }
   void run_once() override {
-    if (m_step++ % m_every == 0) {
-      check(m_air->step(m_ctx, m_every * m_dt, m_state.x, m_state.v, m_solver->model().mass,
-                        &m_force),
-            "lcp-wind: the air blew up");
-    }
-    hair::LcpStepInput in;
-    in.dt = m_dt;
-    in.external_force = &m_force;
-    check(m_solver->step(m_ctx, in, m_state, m_ws), "lcp-wind: the hair blew up");
+    check(m_coupling.step(m_ctx, *m_solver, m_state, m_ws, *m_air, m_dt), "lcp-wind: blow-up");
   }
   double items_per_iter() const override { return 1.0; }
 
@@ -148,11 +139,9 @@ class LcpWindInstance : public WorkloadInstance {
   hair::LcpState m_state;
   hair::LcpWorkspace m_ws;
   std::unique_ptr<hair::SphAir> m_air;
-  std::vector<Vec3> m_force;
+  hair::LcpWindCoupling m_coupling{1};
   double m_nh = 0, m_na = 0;
   double m_dt = 0;  // [s] one hair step
-  int m_every = 1;  // hair steps per air step
-  long m_step = 0;  // hair steps taken
 };
 
 }  // namespace

@@ -66,6 +66,27 @@ LcpStrandBlock lcp_strand_block(int nx, int nz, int len, double a) {
   return b;
 }
 
+int LcpWindCoupling::air_every(const Context& ctx, const SphAir& air, double dt) {
+  const double k = std::floor(air.stable_step(ctx, true) / dt);
+  return std::isfinite(k) && k > 1 ? int(std::min(k, 1e6)) : 1;
+}
+
+LcpStepReport LcpWindCoupling::step(const Context& ctx, const LcpSolver& solver, LcpState& s,
+                                    LcpWorkspace& ws, SphAir& air, double dt) {
+  if (m_calls++ % m_every == 0) {
+    const sim::StepReport ar = air.step(ctx, m_every * dt, s.x, s.v, solver.model().mass, &m_force);
+    if (!ar.ok) {
+      LcpStepReport r;
+      static_cast<sim::StepReport&>(r) = ar;
+      return r;
+    }
+  }
+  LcpStepInput in;
+  in.dt = dt;
+  in.external_force = &m_force;
+  return solver.step(ctx, in, s, ws);
+}
+
 LcpScenario::LcpScenario(const Context& ctx, const LcpScenarioParams& params, const LcpParams& lcp,
                          const geom::TriMesh* head_mesh, const image::ImageF* length_map)
     : m_p(params) {

@@ -174,4 +174,26 @@ struct LcpStrandBlock {
 };
 LcpStrandBlock lcp_strand_block(int nx, int nz, int len, double a);
 
+/// Multi-rate hair-air coupling (§3.6, ADR 0009) for hair whose head frame is the world frame
+/// (head at rest; LcpScenario maps the frames itself and couples once per scenario step): each
+/// step() advances the hair by one step of dt and, on every `every`-th call starting with the
+/// first, the air by every dt first; the air's mean drag over its step is the hair's external
+/// force until the next air step.
+class LcpWindCoupling {
+ public:
+  explicit LcpWindCoupling(int every) : m_every(std::max(1, every)) {}
+  /// Hair steps of dt per air step when the air takes its own stable step
+  /// (SphAir::stable_step with hair), at least 1.
+  static int air_every(const Context& ctx, const SphAir& air, double dt);
+  /// A failed air step is returned as the report (the hair is not stepped).
+  LcpStepReport step(const Context& ctx, const LcpSolver& solver, LcpState& s, LcpWorkspace& ws,
+                     SphAir& air, double dt);
+  int every() const { return m_every; }
+
+ private:
+  int m_every = 1;
+  long m_calls = 0;
+  std::vector<Vec3> m_force;  // [N] the air's mean drag on each hair particle
+};
+
 }  // namespace follicle::hair

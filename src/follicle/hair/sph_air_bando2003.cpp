@@ -217,9 +217,9 @@ sim::StepReport SphAir::step(const Context& ctx, double dt, const std::vector<Ve
           Check c;
           for (std::size_t i = i0; i < i1; ++i) {
             const double sp = m_v[i].norm();
-            const bool bad = !m_x[i].allFinite() || !m_v[i].allFinite() || sp > m_p.max_speed;
-            if (bad && c.bad == SIZE_MAX) c.bad = i;
-            c.non_finite |= bad && !(m_x[i].allFinite() && m_v[i].allFinite());
+            const bool finite = m_x[i].allFinite() && m_v[i].allFinite();
+            if ((!finite || sp > m_p.max_speed) && c.bad == SIZE_MAX) c.bad = i;
+            c.non_finite |= !finite;
             if (std::isfinite(sp)) c.vmax = std::max(c.vmax, sp);
             c.outside |= outside(m_x[i]);
           }

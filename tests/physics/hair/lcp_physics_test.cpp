@@ -309,7 +309,7 @@ TEST(LcpPhysics, AirAtItsOwnStableStepMovesTheHairAsTheTightCoupling) {
   LcpState s0 = solver.rest_state();
   LcpWorkspace probe;
   const double dt = LcpParams{}.cfl / solver.stiffness_rate(ctx, s0, probe);
-  const int k = int(std::floor(SphAir(ctx, ap).stable_step(ctx, true) / dt));
+  const int k = LcpWindCoupling::air_every(ctx, SphAir(ctx, ap), dt);
   ASSERT_GE(k, 4) << "the air's stable step should be several hair sub-steps";
   Vec3 disp[2];
   double air_vz[2];
@@ -318,16 +318,9 @@ TEST(LcpPhysics, AirAtItsOwnStableStepMovesTheHairAsTheTightCoupling) {
     LcpState s = solver.rest_state();
     LcpWorkspace ws;
     SphAir air(ctx, ap);
-    std::vector<Vec3> f;
+    LcpWindCoupling coupling(every);
     for (int step = 0; step < 40 * k; ++step) {
-      if (step % every == 0) {
-        const auto ar = air.step(ctx, every * dt, s.x, s.v, solver.model().mass, &f);
-        ASSERT_TRUE(ar.ok) << ar.message;
-      }
-      LcpStepInput in;
-      in.dt = dt;
-      in.external_force = &f;
-      const auto r = solver.step(ctx, in, s, ws);
+      const auto r = coupling.step(ctx, solver, s, ws, air, dt);
       ASSERT_TRUE(r.ok) << r.message;
     }
     disp[mode] = Vec3::Zero();

@@ -26,7 +26,8 @@ TEST(SphAir, OutflowRemovesAndInflowRefillsTheBox) {
   // inflow spawns one, so the count stays within a layer of the full box and every particle
   // stays inside it.
   Context ctx(2);
-  SphAir air(ctx, small_box());
+  const SphAirParams p = small_box();
+  SphAir air(ctx, p);
   ASSERT_EQ(air.size(), 250u);
   const std::vector<Vec3> none;
   const std::vector<double> no_mass;
@@ -37,7 +38,7 @@ TEST(SphAir, OutflowRemovesAndInflowRefillsTheBox) {
     EXPECT_LE(air.size(), 275u);
     for (const auto& x : air.positions()) {
       ASSERT_TRUE((x.array() >= 0).all()) << x.transpose();
-      ASSERT_TRUE((x.array() <= small_box().box_max.array()).all()) << x.transpose();
+      ASSERT_TRUE((x.array() <= p.box_max.array()).all()) << x.transpose();
     }
   }
   // 0.1 s at 2 m/s: every initial particle has left; the air still moves with the wind.
