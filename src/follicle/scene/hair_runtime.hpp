@@ -2,13 +2,16 @@
 // Internal to the scene module: the hair state a Session keeps (styled strands, solver state,
 // strand cache, head-motion track). Included by session.cpp and session_hair.cpp only.
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "follicle/anim/rigid_motion.hpp"
 #include "follicle/geom/strands.hpp"
-#include "follicle/hair/projective_anjyo1992.hpp"
+#include "follicle/hair/groom.hpp"
+#include "follicle/hair/hair_model.hpp"
 #include "follicle/scene/session.hpp"
 #include "follicle/sim/ellipsoid.hpp"
 
@@ -18,16 +21,17 @@ class HairRuntime {
  public:
   struct Group {
     bool built = false;
-    sim::Ellipsoid hull;  // scene coordinates, at rest
-    std::shared_ptr<const geom::StrandSet> styled;
-    std::unique_ptr<hair::ProjectiveSolver> solver;
-    hair::ProjectiveState state;
-    int state_frame = -1;  // frame `state` belongs to (-1: none yet)
+    sim::Ellipsoid hull;                            // scene coordinates, at rest
+    std::shared_ptr<const hair::Groom> groom;       // scene coordinates, at rest, roots bound
+    std::shared_ptr<const geom::StrandSet> styled;  // groom->strands
+    std::unique_ptr<hair::HairSimulation> sim;
+    int state_frame = -1;  // frame the simulation state belongs to (-1: none yet)
     int last_frame = -1;   // frame of `last`
     std::shared_ptr<const geom::StrandSet> last;
   };
   std::vector<Group> groups;
   HairStats stats;
+  std::map<std::string, std::shared_ptr<const geom::StrandSet>> groom_files;  // by file|units
   std::filesystem::path cache_dir;
   bool cache_ready = false;
   bool track_built = false;

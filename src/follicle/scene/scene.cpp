@@ -45,6 +45,15 @@ void Scene::validate(const JsonSource& src) const {
     if (!m.name.empty() && !names.insert(m.name).second)
       json_fail(src, p + ".name", "duplicate mesh name \"" + m.name + "\"");
   }
+  std::set<std::string> groom_names;
+  for (std::size_t i = 0; i < assets.grooms.size(); ++i) {
+    const auto& g = assets.grooms[i];
+    const std::string p = index_path("assets.grooms", i);
+    if (g.name.empty()) json_fail(src, p + ".name", "groom name is empty");
+    if (g.path.empty()) json_fail(src, p + ".path", "groom path is empty");
+    if (!groom_names.insert(g.name).second)
+      json_fail(src, p + ".name", "duplicate groom name \"" + g.name + "\"");
+  }
   for (std::size_t i = 0; i < lights.size(); ++i) {
     if (lights[i].direction.norm() < 1e-12)
       json_fail(src, index_path("lights", i) + ".direction", "light direction is zero");
@@ -60,6 +69,14 @@ void Scene::validate(const JsonSource& src) const {
                 "no mesh asset named \"" + h.mesh + "\"" +
                     (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
                     "; hair grows on a mesh of assets.meshes with that name");
+    }
+    if (!h.groom.empty() && !groom_names.count(h.groom)) {
+      const std::vector<std::string> known(groom_names.begin(), groom_names.end());
+      const std::string hint = suggest(h.groom, known);
+      json_fail(src, p + ".groom",
+                "no groom asset named \"" + h.groom + "\"" +
+                    (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
+                    "; name one of assets.grooms, or leave \"groom\" out to generate the hair");
     }
     try {
       h.dynamics.validate();

@@ -96,12 +96,35 @@ struct MeshAsset {
   }
 };
 
+/// A groom file (strands): any hair model of a hair[] entry can run it ("groom": name).
+struct GroomAsset {
+  static constexpr const char* kRequired[] = {"name", "path", "units"};
+  std::string name;  // hair[].groom refers to it
+  std::string path;  // relative to the scene file
+  LengthUnit units = LengthUnit::m;
+  Transform transform;
+
+  template <class V>
+  void visit(V&& v) {
+    v("name", name, ParamInfo{"identifier hair[].groom uses to refer to this groom"});
+    v("path", path,
+      ParamInfo{"strand file (.hair, .tfx, .usda BasisCurves, OBJ polylines), relative to the "
+                "scene file"});
+    v("units", units,
+      ParamInfo{"length unit of the coordinates in the file (a .usda's metersPerUnit wins)"});
+    v("transform", transform,
+      ParamInfo{"placement in the scene (use the same as the mesh the hair grows on)"});
+  }
+};
+
 struct Assets {
   std::vector<MeshAsset> meshes;
+  std::vector<GroomAsset> grooms;
 
   template <class V>
   void visit(V&& v) {
     v("meshes", meshes, ParamInfo{"triangle meshes"});
+    v("grooms", grooms, ParamInfo{"groom files any hair model can run (hair[].groom)"});
   }
 };
 

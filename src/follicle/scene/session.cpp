@@ -60,6 +60,12 @@ void Session::validate() const {
         json_fail(src, p + ".material.texture", "texture file not found: " + tex.string());
     }
   }
+  for (std::size_t i = 0; i < m_scene.assets.grooms.size(); ++i) {
+    const auto file = resolve(m_scene.assets.grooms[i].path);
+    if (!std::filesystem::is_regular_file(file))
+      json_fail(src, index_path("assets.grooms", i) + ".path",
+                "groom file not found: " + file.string());
+  }
   if (m_scene.hand && !std::filesystem::is_directory(resolve(m_scene.hand->makehuman)))
     json_fail(src, "hand.makehuman",
               "MakeHuman folder not found: " + resolve(m_scene.hand->makehuman).string());
@@ -113,6 +119,7 @@ void Session::load_all_assets() {
     if (!m_scene.assets.meshes[i].material.texture.empty())
       texture(m_scene.assets.meshes[i].material.texture);
   }
+  for (std::size_t i = 0; i < m_scene.assets.grooms.size(); ++i) groom_strands(i);
   load_skin_setups();  // session_skin.cpp
 }
 

@@ -1,0 +1,141 @@
+// Grooms as assets (issue 20, ADR 0010): assets.grooms[] loads strand files with units and a
+// transform, hair[].groom runs them with any model, errors name the JSON path, the strand cache
+// works for imported grooms.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "follicle/core/error.hpp"
+#include "follicle/geom/strand_io.hpp"
+#include "follicle/scene/session.hpp"
+#include "scene_test_util.hpp"
+#include "testing/testing.hpp"
+
+using namespace follicle;
+using namespace follicle::scene;
+using namespace follicle::scene::testutil;
+using ::testing::HasSubstr;
+
+namespace {
+
+// The bob's styled strands at a low density, written to `file` in millimetres.
+geom::StrandSet write_bob_groom(const std::filesystem::path& file, const Context& ctx) {
+  Json j = scene_json("anjyo_bob");
+  j["hair"][0]["density_scale"] = 0.03;
+  Session s = Session::from_json(j, scenes_dir(), "anjyo_bob", ctx);
+  const geom::StrandSet strands = *s.hair_strands(0, 0);
+  geom::save_strands(strands, file, LengthUnit::mm);
+  return strands;
+}
+
+Json groom_scene(const std::filesystem::path& file, const std::string& units) {
+  Json j = scene_json("anjyo_shake");
+  j["assets"]["grooms"] = Json::array();
+  j["assets"]["grooms"].push_back({{"name", "bob"}, {"path", file.string()}, {"units", units}});
+  j["hair"][0]["groom"] = "bob";
+  j["animation"]["frames"] = 4;
+  return j;
+}
+
+std::string session_error(const Json& j, const Context& ctx) {
+  try {
+    Session s = Session::from_json(j, scenes_dir(), "g.json", ctx);
+    s.hair_strands(0, 0);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(GroomScene, AnImportedGroomIsTheHairAtRestAndRunsTheDynamics) {
+  const Context ctx(2, 1);
+  const auto dir = test::scratch_dir("groom_scene");
+  const auto file = dir / "bob.hair";
+  const geom::StrandSet ref = write_bob_groom(file, ctx);
+  ASSERT_GT(ref.num_strands(), 100u);
+
+  Json j = groom_scene(file, "mm");
+  Session s = Session::from_json(j, scenes_dir(), "g.json", ctx);
+  const auto groom = s.hair_groom(0);
+  ASSERT_EQ(groom->num_strands(), ref.num_strands());
+  ASSERT_EQ(groom->strands.num_points(), ref.num_points());
+  for (std::size_t i = 0; i < ref.num_points(); ++i)
+    ASSERT_LT((groom->strands.points[i] - ref.points[i]).norm(), 1e-6f) << i;
+  ASSERT_EQ(groom->roots.size(), ref.num_strands());  // bound to the head
+  // Frame 0 is the groom at rest; later frames move (head shake).
+  const auto f0 = s.hair_strands(0, 0);
+  for (std::size_t i = 0; i < ref.num_points(); ++i)
+    ASSERT_LT((f0->points[i] - ref.points[i]).norm(), 1e-5f) << i;
+  const auto f3 = s.hair_strands(0, 3);
+  double moved = 0;
+  for (std::size_t i = 0; i < ref.num_points(); ++i)
+    moved = std::max(moved, double((f3->points[i] - ref.points[i]).norm()));
+  EXPECT_GT(moved, 1e-3);
+
+  // The asset transform places the groom; segment_length resamples it.
+  j["assets"]["grooms"][0]["transform"] = {{"translate", {0.0, 0.01, 0.0}}};
+  j["hair"][0]["segment_length"] = 0.02;
+  Session t = Session::from_json(j, scenes_dir(), "g.json", ctx);
+  const auto moved_groom = t.hair_groom(0);
+  EXPECT_EQ(moved_groom->num_strands(), ref.num_strands());
+  EXPECT_NEAR(moved_groom->strands.points[0].y(), ref.points[0].y() + 0.01f, 1e-6);
+  EXPECT_LT(moved_groom->strands.num_points(), ref.num_points());
+}
+
+TEST(GroomScene, StrandCacheWorksForImportedGrooms) {
+  const Context ctx(2, 1);
+  const auto dir = test::scratch_dir("groom_scene_cache");
+  const auto file = dir / "bob.hair";
+  write_bob_groom(file, ctx);
+  const Json j = groom_scene(file, "mm");
+  Session a = Session::from_json(j, scenes_dir(), "g.json", ctx);
+  a.set_strand_cache(dir / "cache");
+  const auto fa = a.hair_strands(0, 3);
+  EXPECT_GT(a.hair_stats().steps, 0u);
+  EXPECT_EQ(a.hair_stats().cache_writes, 4u);
+  Session b = Session::from_json(j, scenes_dir(), "g.json", ctx);
+  b.set_strand_cache(dir / "cache");
+  const auto fb = b.hair_strands(0, 3);
+  EXPECT_EQ(b.hair_stats().steps, 0u);
+  EXPECT_EQ(b.hair_stats().cache_reads, 1u);
+  EXPECT_EQ(fa->points, fb->points);
+}
+
+TEST(GroomScene, BadGroomsNameTheJsonPath) {
+  const Context ctx(1, 1);
+  const auto dir = test::scratch_dir("groom_scene_bad");
+  const auto file = dir / "bob.hair";
+  write_bob_groom(file, ctx);
+
+  Json j = groom_scene(file, "mm");
+  j["hair"][0]["groom"] = "bobb";
+  EXPECT_THAT(read_error(j), HasSubstr("hair[0].groom"));
+  EXPECT_THAT(read_error(j), HasSubstr("did you mean \"bob\""));
+
+  j = groom_scene(file, "mm");
+  j["assets"]["grooms"].push_back(j["assets"]["grooms"][0]);
+  EXPECT_THAT(read_error(j), HasSubstr("duplicate groom name"));
+
+  j = groom_scene(file, "mm");
+  j["assets"]["grooms"][0].erase("units");
+  EXPECT_THAT(read_error(j), HasSubstr("assets.grooms[0]"));
+
+  j = groom_scene(dir / "missing.hair", "mm");
+  EXPECT_THAT(session_error(j, ctx), HasSubstr("assets.grooms[0].path"));
+
+  // A truncated file: the error names the groom asset and the file.
+  {
+    std::ifstream in(file, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    std::ofstream out(dir / "cut.hair", std::ios::binary);
+    out << bytes.substr(0, bytes.size() / 2);
+  }
+  j = groom_scene(dir / "cut.hair", "mm");
+  const std::string e = session_error(j, ctx);
+  EXPECT_THAT(e, HasSubstr("assets.grooms[0]"));
+  EXPECT_THAT(e, HasSubstr("cut.hair"));
+}
