@@ -1,8 +1,10 @@
-// follicle info FILE: a summary of a scene, mesh or hair strand file.
+// follicle info FILE: a summary of a scene, mesh or hair strand file (.hair, .tfx, .usda, .obj
+// polylines): strands, points, strand lengths and bounds.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 
@@ -44,11 +46,27 @@ void mesh_info(const std::string& path, LengthUnit unit) {
   fmt::print("surface area: {:.6g} m^2\n", area);
 }
 
+// "cm", or "0.0254 m" for a USD metersPerUnit that is not one of ours.
+std::string unit_label(double metres_per_unit) {
+  for (LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::dm, LengthUnit::m})
+    if (std::abs(unit_to_metres(u) - metres_per_unit) <= 1e-12 * metres_per_unit)
+      return to_string(u);
+  return fmt::format("{} m", metres_per_unit);
+}
+
+// Strand files: lengths and bounds in the file's unit (USD: its metersPerUnit, else --units).
 void hair_info(const std::string& path, LengthUnit unit) {
-  const auto s = geom::load_strands(path, unit);
-  const double k = 1.0 / unit_to_metres(unit);
+  geom::StrandFileInfo info;
+  const auto s = geom::load_strands(path, unit, &info);
+  const double k = 1.0 / info.metres_per_unit;
+  const std::string label = unit_label(info.metres_per_unit);
   fmt::print("hair: {}\n", path);
-  fmt::print("units: {} (as declared with --units)\n", to_string(unit));
+  fmt::print("format: {}\n", info.format);
+  if (info.unit_from_file)
+    fmt::print("units: {} (metersPerUnit {} from the file; --units is ignored)\n", label,
+               info.metres_per_unit);
+  else
+    fmt::print("units: {} (as declared with --units)\n", label);
   fmt::print("strands: {}\n", s.num_strands());
   fmt::print("points: {}\n", s.num_points());
   fmt::print("segments: {}\n",
@@ -71,13 +89,13 @@ void hair_info(const std::string& path, LengthUnit unit) {
   }
   const Vec3 lo = box.min() * k, hi = box.max() * k;
   fmt::print("points per strand: min {}, max {}\n", pmin, pmax);
-  fmt::print("bounds min: [{:.6g}, {:.6g}, {:.6g}] {}\n", lo.x(), lo.y(), lo.z(), to_string(unit));
-  fmt::print("bounds max: [{:.6g}, {:.6g}, {:.6g}] {}\n", hi.x(), hi.y(), hi.z(), to_string(unit));
+  fmt::print("bounds min: [{:.6g}, {:.6g}, {:.6g}] {}\n", lo.x(), lo.y(), lo.z(), label);
+  fmt::print("bounds max: [{:.6g}, {:.6g}, {:.6g}] {}\n", hi.x(), hi.y(), hi.z(), label);
   fmt::print("strand length: min {:.6g}, mean {:.6g}, max {:.6g} {}\n", lmin * k,
-             lsum * k / double(std::max<std::size_t>(1, s.num_strands())), lmax * k,
-             to_string(unit));
+             lsum * k / double(std::max<std::size_t>(1, s.num_strands())), lmax * k, label);
   fmt::print("radius: {}, colour: {}\n", s.radius.empty() ? "no" : "per point",
              s.color.empty() ? "no" : "per point");
+  for (const auto& n : info.notes) fmt::print("note: {}\n", n);
 }
 
 }  // namespace
@@ -90,17 +108,18 @@ int run_info(const GlobalOptions& g, const InfoArgs& a) {
     fmt::print("{}", session.summary());
     return 0;
   }
+  // An .obj with `l` polylines and no faces holds hair strands; otherwise it is a mesh.
+  if (geom::is_strand_file(a.file)) {
+    hair_info(a.file, parse_length_unit(a.units));
+    return 0;
+  }
   if (ext == ".obj" || ext == ".ply" || ext == ".gltf" || ext == ".glb") {
     mesh_info(a.file, parse_length_unit(a.units));
     return 0;
   }
-  if (ext == ".hair" || ext == ".tfx") {
-    hair_info(a.file, parse_length_unit(a.units));
-    return 0;
-  }
   fail_at(a.file,
           "unknown file type '{}': expected a scene (.json), a mesh (.obj, .ply, .gltf, .glb) or "
-          "hair (.hair, .tfx)",
+          "hair (.hair, .tfx, .usda, .usd, .obj polylines)",
           ext);
 }
 

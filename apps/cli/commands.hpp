@@ -104,6 +104,18 @@ struct AnimateArgs {
 };
 int run_animate(const GlobalOptions& g, const AnimateArgs& a);
 
+struct HarnessArgs {
+  std::string scene;
+  std::string frames;        // "A-B", "" = every frame of the scene
+  std::string models;        // "m1,m2", "" = every hair model
+  std::string group;         // index or name of the hair group, "" = the first
+  std::string sheet_frames;  // "f1,f2,...", "" = first, middle and last
+  int thumb_size = 320;      // [px] width of each picture on the sheet
+  std::string json;          // report (.json), required
+  std::string sheet;         // comparison sheet (.png), required
+};
+int run_harness(const GlobalOptions& g, const HarnessArgs& a);
+
 struct DocsArgs {
   std::string topic;   // "scene-format"
   std::string write;   // file to update in place, "" = print the tables

@@ -132,6 +132,23 @@ int main(int argc, char** argv) {
   animate->add_option("--height", aa.height, "image height in pixels (overrides the scene)")
       ->check(CLI::Range(1, 16384));
 
+  HarnessArgs ha;
+  auto* harness = app.add_subcommand(
+      "harness",
+      "run every hair model on a scene's groom under the same motion; report stretch, "
+      "penetration, root drift, energy and speed (JSON) and a comparison sheet (PNG)");
+  harness->add_option("scene", ha.scene, "scene file (.json) with \"hair\" and \"animation\"")
+      ->required();
+  harness->add_option("--frames", ha.frames, "frame range A-B (default: every frame)");
+  harness->add_option("--models", ha.models, "hair models m1,m2,... (default: all)");
+  harness->add_option("--group", ha.group, "hair group by index or name (default: 0)");
+  harness->add_option("--sheet-frames", ha.sheet_frames,
+                      "frames pictured on the sheet f1,f2,... (default: first, middle, last)");
+  harness->add_option("--thumb-size", ha.thumb_size, "width of each picture in pixels")
+      ->capture_default_str();
+  harness->add_option("--json", ha.json, "report file (.json)");
+  harness->add_option("--sheet", ha.sheet, "comparison sheet (.png)");
+
   DocsArgs da;
   auto* docs = app.add_subcommand("docs", "");  // hidden: an empty group hides it from --help
   docs->group("");
@@ -157,6 +174,7 @@ int main(int argc, char** argv) {
     if (*exp) return run_export(g, ea);
     if (*animate) return run_animate(g, aa);
     if (*compare) return run_compare(g, cma);
+    if (*harness) return run_harness(g, ha);
     return report("no command given (run 'follicle --help')", 2);
   } catch (const UsageError& e) {
     return report(e.what(), 2);

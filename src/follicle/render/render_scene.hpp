@@ -83,8 +83,10 @@ struct MeshItem {
 };
 
 enum class StrandShading {
-  VertexColor,  // colours computed on the CPU (e.g. Anjyo 1992 eq. 8-9) drawn as they are
-  KajiyaKay,    // Kajiya-Kay diffuse + specular from the strand tangent
+  VertexColor,   // colours computed on the CPU (e.g. Anjyo 1992 eq. 8-9) drawn as they are
+  KajiyaKay,     // Kajiya-Kay diffuse + specular from the strand tangent
+  Daldegan1993,  // Daldegan et al. 1993 §4: eq. (7) at every segment endpoint, shadowed by the
+                 // composite shadow buffers, blended on the CPU (hair_blend_daldegan1993.hpp)
 };
 
 struct StrandMaterial {
@@ -96,13 +98,30 @@ struct StrandMaterial {
   double ambient = 0.15;
   double width_px = 1.0;  // line width in output pixels (before supersampling)
   double opacity = 1.0;
+  // The CPU shadow-buffer hair pass (Daldegan1993 shading or StrandItem::hair_shadow): the
+  // lookup of a hair point in a light's composite shadow buffer (Reeves et al. 1987 PCF).
+  double shadow_bias = 1.5;        // [shadow texels] constant depth bias
+  double shadow_slope_bias = 2.0;  // [shadow texels] times cot(angle of the hair to the light)
+  int shadow_filter_radius = 1;    // PCF box of (2 r + 1)^2 texels
 };
 
+/// Strands are drawn by GL lines/ribbons, except items with StrandShading::Daldegan1993 or
+/// hair_shadow, which go through the CPU shadow-buffer hair pass of Daldegan et al. 1993 §4
+/// (hair_blend_daldegan1993.hpp; docs/equations/daldegan_render.md): every light with
+/// cast_shadow gets a hair shadow buffer of the hair_shadow items, composed with the scene's
+/// (so that hair shadows the meshes, in the GL mesh pass for the first shadow light, and
+/// itself), and the hair is blended into the rendered scene as antialiased lines. Colours of
+/// that pass: Daldegan1993 and KajiyaKay shade with eq. (7) (K_A = ambient x colour, K_D =
+/// diffuse x colour, K_S = specular, n = shininess, S_i from each light's composite buffer);
+/// VertexColor keeps its colours c (e.g. Anjyo 1992 eq. 8-9) times (ambient + (1 - ambient) S)
+/// of the first shadow-casting light. cast_shadow concerns the GL shadow map only, which the
+/// CPU-pass items are not drawn into.
 struct StrandItem {
   std::shared_ptr<const geom::StrandSet> strands;
   Affine3 transform = Affine3::Identity();
   StrandMaterial material;
   bool cast_shadow = true;
+  bool hair_shadow = false;  // CPU pass, casting into the hair shadow buffers (see above)
 };
 
 enum class ParticleShading {

@@ -2,7 +2,11 @@
 // over meshes and strands), main pass into a k-times supersampled RGBA16F FBO (meshes, strands,
 // particles), then a resolve pass that box-filters k x k samples in linear space and encodes
 // sRGB into an RGBA8 FBO that is read back. All geometry goes up once per render in VBOs; every
-// item is one draw call.
+// item is one draw call. Strand items of the Daldegan 1993 §4 CPU pass (StrandShading::
+// Daldegan1993 or hair_shadow) are not drawn by GL: every shadow-casting light's scene depth
+// map is read back and composed with the hair's (hair_blend_daldegan1993.hpp), the first
+// shadow light's composite goes back into the shadow map before the mesh pass, and the hair is
+// shaded and blended into the read-back frame after the GL passes.
 #include <GL/gl.h>
 #include <GL/glext.h>
 #include <spdlog/spdlog.h>
@@ -10,12 +14,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 
+#include "follicle/core/parallel.hpp"
 #include "follicle/render/camera.hpp"
 #include "follicle/render/egl_context.hpp"
 #include "follicle/render/gl_util.hpp"
+#include "follicle/render/hair_blend_daldegan1993.hpp"
 #include "follicle/render/renderer.hpp"
 #include "follicle/render/resolve_cpu.hpp"
 #include "follicle/render/shaders_gl.hpp"
@@ -202,6 +209,7 @@ class GlRenderer final : public Renderer {
   GlRenderer(const Context& ctx, std::unique_ptr<EglContext> egl)
       : m_log(ctx.logger_ptr()),
         m_arena(std::make_unique<tbb::task_arena>(ctx.threads())),
+        m_hair_ctx(std::make_unique<Context>(ctx.threads(), ctx.seed(), ctx.logger_ptr())),
         m_egl(std::move(egl)) {
     if (m_egl) m_egl->make_current();
     init();
@@ -489,9 +497,14 @@ class GlRenderer final : public Renderer {
       meshes.push_back(d);
     }
     std::vector<StrandDraw> strands;
+    clear_cpu_hair();
     for (std::size_t i = 0; i < scene.strands.size(); ++i) {
       const StrandItem& item = scene.strands[i];
       if (!item.strands || item.strands->points.empty()) continue;
+      if (is_cpu_hair(item)) {
+        gather_cpu_hair(item, i, k, item.hair_shadow ? sb : nullptr);
+        continue;
+      }
       strands.push_back(upload_strands(fo, item, i, item.cast_shadow ? sb : nullptr));
     }
     const Mat4 view = view_matrix(scene.camera);
@@ -517,22 +530,24 @@ class GlRenderer final : public Renderer {
     Mat4 light_vp = Mat4::Identity();
     double shadow_texel_world = 0, shadow_depth_range = 1;
     const bool shadows = shadow_light >= 0 && !shadow_box.isEmpty();
-    if (shadows) {
+    // Orthographic view-projection of a directional light over the shadow box.
+    auto light_matrix = [&](std::size_t li) {
       const Vec3 c = shadow_box.center();
       const double r = std::max(0.5 * shadow_box.diagonal().norm(), 1e-6);
-      const Vec3 dir = scene.lights[std::size_t(shadow_light)].direction.normalized();
+      const Vec3 dir = scene.lights[li].direction.normalized();
       const Vec3 up = std::abs(dir.y()) < 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
       const Mat4 lv = look_at(c - dir * (2 * r), c, up);
-      light_vp = orthographic(-r, r, -r, r, r * 0.5, r * 3.5) * lv;
-      shadow_texel_world = 2 * r / settings.shadow_map_size;
-      shadow_depth_range = 3 * r;
+      return Mat4(orthographic(-r, r, -r, r, r * 0.5, r * 3.5) * lv);
+    };
+    // The scene's depth map seen through `vp` (meshes and GL strands that cast shadows).
+    auto draw_shadow_casters = [&](const Mat4& vp) {
       glBindFramebuffer(GL_FRAMEBUFFER, m_shadow_fbo);
       glViewport(0, 0, settings.shadow_map_size, settings.shadow_map_size);
       glClear(GL_DEPTH_BUFFER_BIT);
       glEnable(GL_POLYGON_OFFSET_FILL);
       glPolygonOffset(1.5f, 2.0f);
       glUseProgram(m_depth_prog);
-      set_mat4(m_depth_prog, "uLightVP", light_vp);
+      set_mat4(m_depth_prog, "uLightVP", vp);
       for (const MeshDraw& d : meshes) {
         if (!d.item->cast_shadow) continue;
         set_mat4(m_depth_prog, "uModel", d.item->transform.matrix());
@@ -548,6 +563,30 @@ class GlRenderer final : public Renderer {
         glMultiDrawArrays(GL_LINE_STRIP, d.first.data(), d.count.data(), GLsizei(d.first.size()));
       }
       check_gl("shadow pass");
+    };
+    const bool cpu_hair = !m_hair_items.empty();
+    m_hair_shadow.resize(scene.lights.size());
+    for (ShadowBuffer& b : m_hair_shadow) b.size = 0;  // none yet (the memory is kept)
+    if (shadows && cpu_hair) {
+      // Daldegan 1993 §4 steps (1)-(3) for the other shadow-casting lights; they share the
+      // shadow framebuffer, so they go first and the mesh pass's light comes last.
+      for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+        if (!scene.lights[li].cast_shadow || int(li) == shadow_light) continue;
+        const Mat4 vp = light_matrix(li);
+        draw_shadow_casters(vp);
+        hair_shadow_buffer(li, vp, settings.shadow_map_size, false);
+      }
+    }
+    if (shadows) {
+      const Vec3 dir = scene.lights[std::size_t(shadow_light)].direction.normalized();
+      const double r = std::max(0.5 * shadow_box.diagonal().norm(), 1e-6);
+      light_vp = light_matrix(std::size_t(shadow_light));
+      shadow_texel_world = 2 * r / settings.shadow_map_size;
+      shadow_depth_range = 3 * r;
+      draw_shadow_casters(light_vp);
+      // The composite buffer replaces the scene's, so the hair shadows the meshes (step 4).
+      if (cpu_hair)
+        hair_shadow_buffer(std::size_t(shadow_light), light_vp, settings.shadow_map_size, true);
       if (!m_splat->empty()) {
         SplatPassGl::Light sl;
         sl.index = shadow_light;
@@ -606,20 +645,13 @@ class GlRenderer final : public Renderer {
       }
       check_gl("particle pass");
     }
-    if (!m_splat->empty()) {
-      if (settings.hair_view_pass == "gpu")
-        m_splat->view_pass(scene, view, view_proj, m_empty_vao);
-      else if (cpu_frame) {
-        // The whole frame as half floats (a plain copy in llvmpipe, where converting to float
-        // costs 1 ms at 512²), widened exactly on the CPU.
-        const std::size_t nf = 4 * std::size_t(m_fb_w) * std::size_t(m_fb_h);
-        m_cpu_half.resize(nf);
-        cpu_frame->resize(nf);
-        glPixelStorei(GL_PACK_ALIGNMENT, 4);
-        glReadPixels(0, 0, m_fb_w, m_fb_h, GL_RGBA, GL_HALF_FLOAT, m_cpu_half.data());
-        check_gl("frame read-back");
-        m_arena->execute(
-            [&] { m_resolve.half_to_float(m_cpu_half.data(), nf, cpu_frame->data()); });
+    if (!m_splat->empty() && settings.hair_view_pass == "gpu")
+      m_splat->view_pass(scene, view, view_proj, m_empty_vao);
+    // Daldegan 1993 §4 step (5): the CPU-pass hair blended into the rendered scene.
+    const bool frame_on_cpu = cpu_hair && blend_cpu_hair(scene, view_proj, shadow_light, cpu_frame);
+    if (!m_splat->empty() && settings.hair_view_pass != "gpu") {
+      if (cpu_frame) {
+        if (!frame_on_cpu) read_frame(*cpu_frame);
         m_splat->view_pass_cpu(scene, view, view_proj, m_color_tex, m_fb_w, m_fb_h, *m_arena,
                                cpu_frame);
         glBindVertexArray(0);
@@ -627,6 +659,10 @@ class GlRenderer final : public Renderer {
       } else {
         m_splat->view_pass_cpu(scene, view, view_proj, m_color_tex, m_fb_w, m_fb_h, *m_arena);
       }
+    }
+    if (frame_on_cpu) {
+      glBindVertexArray(0);
+      return true;
     }
 
     // ---- resolve ------------------------------------------------------------------------------
@@ -644,6 +680,219 @@ class GlRenderer final : public Renderer {
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     check_gl("resolve");
+    return false;
+  }
+
+  /// The whole colour buffer of the bound framebuffer into `frame` (fb_w x fb_h linear RGBA
+  /// floats, rows bottom up): read as half floats (a plain copy in llvmpipe, where converting
+  /// to float costs 1 ms at 512²), widened exactly on the CPU.
+  void read_frame(std::vector<float>& frame) {
+    const std::size_t nf = 4 * std::size_t(m_fb_w) * std::size_t(m_fb_h);
+    m_cpu_half.resize(nf);
+    frame.resize(nf);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, m_fb_w, m_fb_h, GL_RGBA, GL_HALF_FLOAT, m_cpu_half.data());
+    check_gl("frame read-back");
+    m_arena->execute([&] { m_resolve.half_to_float(m_cpu_half.data(), nf, frame.data()); });
+  }
+
+  // ---- Daldegan 1993 §4 CPU hair pass -----------------------------------------------------------
+
+  static bool is_cpu_hair(const StrandItem& item) {
+    return item.material.shading == StrandShading::Daldegan1993 || item.hair_shadow;
+  }
+
+  struct CpuHairItem {
+    const StrandItem* item = nullptr;
+    std::size_t index = 0;                         // in RenderScene::strands
+    std::size_t strand_begin = 0, strand_end = 0;  // in m_hair
+  };
+
+  void clear_cpu_hair() {
+    m_hair_items.clear();
+    m_hair.points.clear();
+    m_hair.offsets.assign(1, 0);
+    m_hair.radius.clear();
+    m_hair.width_px.clear();
+    m_hair.opacity.clear();
+    m_hair.casts_shadow.clear();
+    m_hair_base.clear();
+  }
+
+  /// Appends a CPU-pass item to m_hair in world space (widths in framebuffer pixels for
+  /// supersampling k), checking it like upload_strands; extends `shadow_box` by its points.
+  void gather_cpu_hair(const StrandItem& item, std::size_t index, int k,
+                       Eigen::AlignedBox3d* shadow_box) {
+    const geom::StrandSet& s = *item.strands;
+    const StrandMaterial& mat = item.material;
+    const std::string where = fmt::format("render: strands[{}]", index);
+    const std::size_t np = s.points.size();
+    if (s.offsets.empty() || s.offsets.front() != 0 || s.offsets.back() != np)
+      fail_at(where, "offsets do not cover the {} points", np);
+    if (!s.color.empty() && s.color.size() != np)
+      fail_at(where, "{} colours for {} points", s.color.size(), np);
+    if (!s.radius.empty() && s.radius.size() != np)
+      fail_at(where, "{} radii for {} points", s.radius.size(), np);
+    if (!(std::isfinite(mat.width_px) && mat.width_px > 0))
+      fail_at(where + ".material.width_px", "{} must be a finite value > 0", mat.width_px);
+    if (!(mat.opacity >= 0 && mat.opacity <= 1))
+      fail_at(where + ".material.opacity", "{} is outside [0, 1]", mat.opacity);
+    if (!mat.color.allFinite() || mat.color.minCoeff() < 0)
+      fail_at(where + ".material.color", "must be finite and >= 0");
+    if (!item.transform.matrix().allFinite()) fail_at(where, "the transform is not finite");
+    if (!m_hair_items.empty() && (s.radius.empty() != m_hair.radius.empty()))
+      fail_at(where,
+              "the CPU hair pass needs radii on all of its strand items or on none (this item "
+              "{} them)",
+              s.radius.empty() ? "lacks" : "has");
+    const std::size_t ns = s.num_strands();
+    for (std::size_t st = 0; st < ns; ++st)
+      if (s.offsets[st + 1] < s.offsets[st]) fail_at(where, "offsets decrease at strand {}", st);
+    for (std::size_t i = 0; i < np; ++i)
+      if (!s.points[i].allFinite()) fail_at(where, "point {} is not finite", i);
+    for (std::size_t i = 0; i < s.radius.size(); ++i)
+      if (!(std::isfinite(s.radius[i]) && s.radius[i] >= 0))
+        fail_at(where, "radius {} of point {} is not a finite value >= 0", s.radius[i], i);
+    if (s.color.size() == np)
+      for (std::size_t i = 0; i < np; ++i)
+        if (!s.color[i].allFinite()) fail_at(where, "colour of point {} is not finite", i);
+    if (m_hair.points.size() + np > std::size_t(std::numeric_limits<uint32_t>::max()))
+      fail_at(where, "the CPU hair pass holds at most 2^32 - 1 points");
+    CpuHairItem h;
+    h.item = &item;
+    h.index = index;
+    h.strand_begin = m_hair.num_strands();
+    const std::size_t p0 = m_hair.points.size();
+    m_hair.points.resize(p0 + np);
+    m_hair_base.resize(p0 + np);
+    const Affine3 xf = item.transform;
+    const Vec3f mc = mat.color.cast<float>();
+    parallel_for(
+        *m_hair_ctx, 0, np,
+        [&](std::size_t i) {
+          m_hair.points[p0 + i] = (xf * s.points[i].cast<double>()).cast<float>();
+          m_hair_base[p0 + i] = s.color.empty() ? mc : s.color[i];
+        },
+        4096);
+    if (!s.radius.empty()) {
+      const float scale = float(linear_scale(xf));
+      m_hair.radius.resize(p0 + np);
+      for (std::size_t i = 0; i < np; ++i) m_hair.radius[p0 + i] = s.radius[i] * scale;
+    }
+    for (std::size_t st = 0; st < ns; ++st)
+      m_hair.offsets.push_back(uint32_t(p0 + s.offsets[st + 1]));
+    m_hair.width_px.resize(m_hair.num_strands(), float(mat.width_px * k));
+    m_hair.opacity.resize(m_hair.num_strands(), float(mat.opacity));
+    m_hair.casts_shadow.resize(m_hair.num_strands(), item.hair_shadow ? 1 : 0);
+    h.strand_end = m_hair.num_strands();
+    m_hair_items.push_back(h);
+    if (shadow_box && np > 0) {
+      Eigen::AlignedBox3f b;
+      for (std::size_t i = p0; i < p0 + np; ++i) b.extend(m_hair.points[i]);
+      shadow_box->extend(b.min().cast<double>());
+      shadow_box->extend(b.max().cast<double>());
+    }
+  }
+
+  /// Steps (1)-(3) for light `li`: the scene's depth map just drawn into the shadow framebuffer
+  /// read back, the hair's drawn on the CPU, their composite kept in m_hair_shadow[li]; with
+  /// `upload` (the mesh pass's light) the composite replaces the shadow map when hair casts.
+  void hair_shadow_buffer(std::size_t li, const Mat4& vp, int size, bool upload) {
+    ShadowBuffer& buf = m_hair_shadow[li];
+    buf.size = size;
+    buf.light_vp = vp;
+    buf.depth.resize(std::size_t(size) * std::size_t(size));
+    glBindFramebuffer(GL_FRAMEBUFFER, m_shadow_fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, size, size, GL_DEPTH_COMPONENT, GL_FLOAT, buf.depth.data());
+    check_gl("shadow map read-back");
+    const bool casts = std::any_of(m_hair.casts_shadow.begin(), m_hair.casts_shadow.end(),
+                                   [](uint8_t c) { return c != 0; });
+    if (!casts) return;
+    m_hair_rasterizer.rasterize(*m_hair_ctx, m_hair, vp, size, m_hair_depth_map);
+    compose_shadow_buffers_into(*m_hair_ctx, buf, m_hair_depth_map);
+    if (!upload) return;
+    glBindTexture(GL_TEXTURE_2D, m_shadow_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_DEPTH_COMPONENT, GL_FLOAT,
+                    m_hair_shadow[li].depth.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    check_gl("composite shadow map upload");
+  }
+
+  /// Step (5): shades the CPU-pass hair (eq. 7, or the shadowed vertex colours) and blends it
+  /// into the colour buffer of m_fbo, tested against its depth. With `cpu_frame` the whole
+  /// frame is read into it and the hair drawn there (returns true: the caller resolves it);
+  /// otherwise only the hair's rectangle is read back and uploaded again (returns false).
+  bool blend_cpu_hair(const RenderScene& scene, const Mat4& view_proj, int shadow_light,
+                      std::vector<float>* cpu_frame) {
+    const Context& ctx = *m_hair_ctx;
+    std::vector<HairLight> lights;
+    for (std::size_t li = 0; li < scene.lights.size(); ++li) {
+      const DirectionalLight& l = scene.lights[li];
+      HairLight h;
+      h.to_light = -l.direction.normalized();
+      h.radiance = l.color * l.intensity;
+      h.shadow = m_hair_shadow[li].size > 0 ? &m_hair_shadow[li] : nullptr;
+      lights.push_back(h);
+    }
+    m_hair_color.resize(m_hair.num_points());
+    for (const CpuHairItem& h : m_hair_items) {
+      const StrandMaterial& mat = h.item->material;
+      HairShading sh;
+      sh.mode = mat.shading == StrandShading::VertexColor ? HairShadingMode::ShadowedColor
+                                                          : HairShadingMode::Daldegan1993;
+      sh.ambient_light = scene.ambient_color;
+      sh.color = mat.color;
+      sh.k_a = mat.ambient;
+      sh.k_d = mat.diffuse;
+      sh.k_s = mat.specular;
+      sh.n = mat.shininess;
+      sh.shadow_bias = mat.shadow_bias;
+      sh.shadow_slope_bias = mat.shadow_slope_bias;
+      sh.shadow_filter_radius = mat.shadow_filter_radius;
+      sh.key_light = shadow_light;
+      const std::string where = fmt::format("render: strands[{}].material", h.index);
+      sh.check(where);
+      shade_hair_vertices(ctx, m_hair, h.strand_begin, h.strand_end, m_hair_base, sh, lights,
+                          scene.camera.eye, m_hair_color);
+    }
+    m_hair_blender.prepare(ctx, view_proj, m_hair, m_fb_w, m_fb_h);
+    const std::array<int, 4> box = m_hair_blender.bounds();
+    glBindFramebuffer(GL_FRAMEBUFFER, m_fbo);
+    if (cpu_frame) read_frame(*cpu_frame);
+    if (box[0] >= box[2]) return cpu_frame != nullptr;  // no hair on screen
+    HairFrame tg;
+    tg.fb_width = m_fb_w;
+    tg.fb_height = m_fb_h;
+    tg.x0 = box[0];
+    tg.y0 = box[1];
+    tg.width = box[2] - box[0];
+    tg.height = box[3] - box[1];
+    const std::size_t npix = std::size_t(tg.width) * std::size_t(tg.height);
+    m_hair_depth.resize(npix);
+    if (cpu_frame) {
+      tg.rgba =
+          cpu_frame->data() + 4 * (std::size_t(tg.y0) * std::size_t(m_fb_w) + std::size_t(tg.x0));
+      tg.rgba_stride = m_fb_w;
+    } else {
+      m_hair_rgba.resize(4 * npix);
+      glPixelStorei(GL_PACK_ALIGNMENT, 4);
+      glReadPixels(tg.x0, tg.y0, tg.width, tg.height, GL_RGBA, GL_FLOAT, m_hair_rgba.data());
+      tg.rgba = m_hair_rgba.data();
+    }
+    glReadPixels(tg.x0, tg.y0, tg.width, tg.height, GL_DEPTH_COMPONENT, GL_FLOAT,
+                 m_hair_depth.data());
+    check_gl("hair pass read-back");
+    tg.depth = m_hair_depth.data();
+    m_hair_blender.blend(ctx, m_hair, m_hair_color, tg);
+    if (cpu_frame) return true;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glBindTexture(GL_TEXTURE_2D, m_color_tex);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, tg.x0, tg.y0, tg.width, tg.height, GL_RGBA, GL_FLOAT,
+                    m_hair_rgba.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    check_gl("hair pass upload");
     return false;
   }
 
@@ -904,7 +1153,19 @@ class GlRenderer final : public Renderer {
   std::unique_ptr<tbb::task_arena> m_arena;  // the CPU hair view pass's threads (ctx.threads())
   std::vector<float> m_cpu_frame;            // the frame read back for the CPU view pass
   std::vector<uint16_t> m_cpu_half;          // ... as read (half floats)
-  CpuResolve m_resolve;                      // its resolve tables
+  std::unique_ptr<Context> m_hair_ctx;       // threads of the Daldegan 1993 CPU hair pass
+  // The Daldegan 1993 §4 CPU hair pass: its items, their world-space segments, base and shaded
+  // colours per point, composite shadow buffers per light (size 0: none), the blender and the
+  // read-back window.
+  std::vector<CpuHairItem> m_hair_items;
+  HairSegments m_hair;
+  std::vector<Vec3f> m_hair_base, m_hair_color;
+  std::vector<ShadowBuffer> m_hair_shadow;
+  HairDepthRasterizer m_hair_rasterizer;
+  ShadowBuffer m_hair_depth_map;  // the hair's own depth map of the light being composed
+  HairBlender m_hair_blender;
+  std::vector<float> m_hair_rgba, m_hair_depth;
+  CpuResolve m_resolve;  // its resolve tables
   std::unique_ptr<EglContext> m_egl;
   std::string m_description;
   std::map<int, GLuint> m_mesh_progs;

@@ -12,6 +12,7 @@
 #include "follicle/geom/strands.hpp"
 #include "follicle/hair/groom.hpp"
 #include "follicle/hair/hair_model.hpp"
+#include "follicle/hair/hairstyler_daldegan1993.hpp"
 #include "follicle/scene/session.hpp"
 #include "follicle/sim/ellipsoid.hpp"
 
@@ -24,6 +25,12 @@ class HairRuntime {
     sim::Ellipsoid hull;                            // scene coordinates, at rest
     std::shared_ptr<const hair::Groom> groom;       // scene coordinates, at rest, roots bound
     std::shared_ptr<const geom::StrandSet> styled;  // groom->strands
+    std::vector<hair::HairMaterial> materials;      // of a HairStyler groom (else empty)
+    // Roots riding a skin rig's deforming surface (the hair's mesh has a skin[] rig): the roots
+    // bound to the rig's refined rest mesh, and those bound points at rest (scene coordinates).
+    std::optional<std::size_t> skin_rig;
+    hair::Groom skin_binding;
+    std::vector<Vec3> skin_rest_roots;
     std::unique_ptr<hair::HairSimulation> sim;
     int state_frame = -1;  // frame the simulation state belongs to (-1: none yet)
     int last_frame = -1;   // frame of `last`

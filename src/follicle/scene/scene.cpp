@@ -84,6 +84,11 @@ void Scene::validate(const JsonSource& src) const {
       json_fail(src, p + ".dynamics", e.what());
     }
     try {
+      h.daldegan.validate();
+    } catch (const Error& e) {
+      json_fail(src, p + ".daldegan", e.what());
+    }
+    try {
       h.shading.validate();
     } catch (const Error& e) {
       json_fail(src, p + ".shading", e.what());
@@ -109,6 +114,10 @@ void Scene::validate(const JsonSource& src) const {
       json_fail(
           src, "animation.head_motion.interp",
           "unknown value \"" + m.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
+    if (a.wind.velocity_gust && !(a.wind.velocity_gust->t1 >= a.wind.velocity_gust->t0))
+      json_fail(src, "animation.wind.velocity_gust.t1",
+                fmt::format("t1 ({}) must not be before t0 ({})", a.wind.velocity_gust->t1,
+                            a.wind.velocity_gust->t0));
     if (m.kind == HeadMotionKind::Keyframes && m.keys.empty())
       json_fail(src, "animation.head_motion.keys", "kind \"keyframes\" needs at least one key");
     for (std::size_t k = 1; k < m.keys.size(); ++k)

@@ -172,6 +172,10 @@ render::RenderScene Session::render_scene(int frame) {
                                                : Vec3(-m_scene.lights[0].direction.normalized());
   for (std::size_t i = 0; i < m_scene.hair.size(); ++i) {
     const auto& h = m_scene.hair[i];
+    if (h.model == HairModel::Daldegan1993) {
+      add_daldegan_items(rs, i, frame);
+      continue;
+    }
     auto shaded = std::make_shared<geom::StrandSet>(*hair_strands(i, frame));
     hair::shade_anjyo1992(*m_ctx, *shaded, h.shading, c.eye, to_light, h.seed);
     render::StrandItem item;
@@ -180,12 +184,55 @@ render::RenderScene Session::render_scene(int frame) {
     item.material.color = h.shading.hair_color;
     item.material.width_px = h.render.width_px;
     item.material.opacity = h.render.opacity;
-    item.cast_shadow = false;  // 1-px lines make a speckled shadow map; the paper has no shadows
+    // Without the hair shadow buffers: 1-px lines make a speckled GL shadow map, and Anjyo 1992
+    // has no shadows. With them (render.shadow), the CPU hair pass shadows hair and skin.
+    item.cast_shadow = false;
+    item.hair_shadow = h.render.shadow;
     rs.strands.push_back(std::move(item));
   }
   add_hand_items(rs, frame);  // session_hand.cpp
   add_lcp_items(rs, frame);   // session_lcp.cpp
   return rs;
+}
+
+void Session::add_daldegan_items(render::RenderScene& rs, std::size_t gi, int frame) {
+  // Daldegan 1993 §4: one strand item per hair material (eq. (7) coefficients), drawn by the
+  // shadow-buffer hair pass.
+  const auto& h = m_scene.hair[gi];
+  const auto strands = hair_strands(gi, frame);
+  const auto groom = hair_groom(gi);
+  std::vector<hair::HairMaterial> materials = hair_runtime().groups[gi].materials;
+  if (materials.empty()) {  // an imported or Anjyo-styled groom: one material, the hair colour
+    hair::HairMaterial m;
+    m.color = h.shading.hair_color;
+    materials.push_back(m);
+  }
+  std::vector<geom::StrandSet> parts(materials.size());
+  for (std::size_t s = 0; s < strands->num_strands(); ++s) {
+    const std::size_t m = groom->material.empty() ? 0 : groom->material[s];
+    auto& part = parts[std::min(m, parts.size() - 1)];
+    const uint32_t b = strands->strand_begin(s);
+    part.points.insert(part.points.end(), strands->points.begin() + b,
+                       strands->points.begin() + b + strands->strand_size(s));
+    part.offsets.push_back(uint32_t(part.points.size()));
+  }
+  for (std::size_t m = 0; m < parts.size(); ++m) {
+    if (parts[m].num_strands() == 0) continue;
+    const auto& mat = materials[m];
+    render::StrandItem item;
+    item.strands = std::make_shared<const geom::StrandSet>(std::move(parts[m]));
+    item.material.shading = render::StrandShading::Daldegan1993;
+    item.material.color = mat.color;
+    item.material.ambient = mat.ambient;
+    item.material.diffuse = mat.diffuse;
+    item.material.specular = mat.specular;
+    item.material.shininess = mat.shininess;
+    item.material.width_px = h.render.width_px;
+    item.material.opacity = h.render.opacity;
+    item.cast_shadow = false;
+    item.hair_shadow = true;
+    rs.strands.push_back(std::move(item));
+  }
 }
 
 render::RenderSettings Session::render_settings() const {
