@@ -5,7 +5,8 @@ describes). With --check, fails when the generated files are out of date."""
 import sys
 from pathlib import Path
 
-ORDER = ["summary", "geom", "render", "splat", "anjyo", "hair_render", "skin", "fine", "lcp"]
+ORDER = ["summary", "geom", "render", "splat", "anjyo", "hair_render", "skin", "fine", "lcp",
+         "daldegan_styler", "daldegan_dynamics", "daldegan_render", "daldegan"]
 
 HEADERS = {
     "equations": (
@@ -15,7 +16,7 @@ HEADERS = {
         "edit those parts.\n\n"
         "Papers: Anjyo, Usami & Kurihara 1992 (`shared/papers/001_*`); Bando 2003 MSc thesis "
         "(`000_*`, chapters 2 and 3); Bando, Kuratate & Nishita 2002 (`002_*`); Daldegan et al. "
-        "1993 (`003_*`, not implemented yet).\n"
+        "1993 (`003_*`).\n"
     ),
     "performance": (
         "# Performance\n\n"

@@ -24,16 +24,6 @@ std::string lower_ext(const std::string& path) {
   return ext;
 }
 
-// --tfx-verts. ConvertArgs::tfx_verts is read once commands.hpp declares it (and main.cpp parses
-// the option); until then .tfx output uses TressFX's usual 32 vertices per strand.
-template <class A>
-long long tfx_verts_of(const A& a) {
-  if constexpr (requires { a.tfx_verts; })
-    return static_cast<long long>(a.tfx_verts);
-  else
-    return 32;
-}
-
 // "cm", or "0.0254 m" for a USD metersPerUnit that is not one of ours.
 std::string unit_label(double metres_per_unit) {
   for (LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::dm, LengthUnit::m})
@@ -49,7 +39,7 @@ int convert_strands(const GlobalOptions& g, const ConvertArgs& a, Context& ctx, 
     fail_at(a.output,
             "cannot write hair strands as '{}': strand outputs are .hair, .tfx, .usda or .obj",
             ext);
-  const long long tv = tfx_verts_of(a);
+  const long long tv = a.tfx_verts;
   if (ext == ".tfx" && (tv < 4 || tv > 64 || (tv & (tv - 1)) != 0))
     throw UsageError(fmt::format("--tfx-verts must be a power of two in [4, 64], got {}", tv));
   const uint32_t tfx_verts = ext == ".tfx" ? uint32_t(tv) : 32;

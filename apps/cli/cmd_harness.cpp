@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 
 #include "commands.hpp"
@@ -152,12 +153,16 @@ int run_harness(const GlobalOptions& g, const HarnessArgs& a) {
 
   std::vector<std::string> stopped;
   if (!g.quiet) {
+    const auto num = [](double v, int decimals) {
+      return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : std::string("-");
+    };
     for (const auto& r : report.models)
       fmt::print(
-          "{}: max stretch {:.4f} %, max penetration {:.2f} mm, root drift {:.4f} mm, {:.0f} ms "
-          "per simulated second{}\n",
-          r.model, r.max_stretch_percent, r.max_penetration_mm, r.root_drift_mm,
-          r.ms_per_simulated_second, r.error.empty() ? "" : " (stopped)");
+          "{}: max stretch {} %, max penetration {} mm, root drift {} mm, {} ms per simulated "
+          "second{}\n",
+          r.model, num(r.max_stretch_percent, 4), num(r.max_penetration_mm, 2),
+          num(r.root_drift_mm, 4), num(r.ms_per_simulated_second, 0),
+          r.error.empty() ? "" : fmt::format(" (stopped after {} frames)", r.frames));
     fmt::print("wrote {} ({} models, frames {}-{})\n", a.json, report.models.size(),
                report.first_frame, report.last_frame);
     fmt::print("wrote {} ({}x{})\n", a.sheet, sheet.width(), sheet.height());

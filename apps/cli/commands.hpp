@@ -56,6 +56,7 @@ struct ConvertArgs {
   std::string input, output;
   std::string in_units = "m", out_units = "m";
   bool ascii = false;
+  int tfx_verts = 32;  // .tfx output: vertices per strand (power of two, 4..64)
 };
 int run_convert(const GlobalOptions& g, const ConvertArgs& a);
 

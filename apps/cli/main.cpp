@@ -56,20 +56,28 @@ int main(int argc, char** argv) {
   InfoArgs ia;
   auto* info = app.add_subcommand("info", "summarize a scene, mesh or hair file");
   info->add_option("file", ia.file,
-                   "scene (.json), mesh (.obj, .ply, .gltf, .glb) or hair (.hair, .tfx)")
+                   "scene (.json), mesh (.obj, .ply, .gltf, .glb) or hair (.hair, .tfx, .usda, "
+                   ".obj lines)")
       ->required();
   info->add_option("--units", ia.units, "length unit of a mesh or hair file: mm, cm, dm, m")
       ->capture_default_str();
 
   ConvertArgs ca;
-  auto* convert = app.add_subcommand("convert", "convert a mesh between OBJ, PLY and glTF");
-  convert->add_option("input", ca.input, "input mesh")->required();
-  convert->add_option("output", ca.output, "output mesh (format from the extension)")->required();
-  convert->add_option("--in-units", ca.in_units, "length unit of the input: mm, cm, dm, m")
+  auto* convert = app.add_subcommand(
+      "convert", "convert a mesh (OBJ, PLY, glTF) or hair strands (.hair, .tfx, .usda, OBJ lines)");
+  convert->add_option("input", ca.input, "input mesh or strand file")->required();
+  convert->add_option("output", ca.output, "output file (format from the extension)")->required();
+  convert
+      ->add_option("--in-units", ca.in_units,
+                   "length unit of the input: mm, cm, dm, m (a .usda's metersPerUnit wins)")
       ->capture_default_str();
   convert->add_option("--out-units", ca.out_units, "length unit to write: mm, cm, dm, m")
       ->capture_default_str();
   convert->add_flag("--ascii", ca.ascii, "write PLY as ASCII instead of binary");
+  convert
+      ->add_option("--tfx-verts", ca.tfx_verts,
+                   "vertices per strand of a .tfx output (power of two, 4..64; resampled)")
+      ->capture_default_str();
 
   BenchArgs ba;
   auto* bench = app.add_subcommand("bench", "run benchmark workloads, one JSON line each");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -30,13 +31,22 @@ inline float reduce_angle(double x) {
   return float(x - 2.0 * kPi * k);
 }
 
+// x - 2π k with k the nearest integer to x / 2π: the angle difference on (-π, π]. The springs
+// (3) pull an angle to the nearest turn of its styled value, so an angle that wound up (φ near a
+// pole of the polar frame) does not unwind turn by turn.
+inline double wrap_pi(double x) {
+  constexpr double inv2pi = 1.0 / (2.0 * kPi), magic = 6755399441055744.0;
+  return x - 2.0 * kPi * ((x * inv2pi + magic) - magic);
+}
+
 // sin and cos of |x| <= ~π in single precision: one reduction to [-π/4, π/4] (3-part Cody-Waite)
 // and the minimax polynomials of Cephes sinf/cosf (about 1 ulp).
 inline void sincos_f(float x, float& s, float& c) {
   constexpr float magic = 12582912.0f;  // 1.5 * 2^23: x + magic rounds x to an integer
   const float k = (x * 0.636619772367581f + magic) - magic;  // 2/π
   const int q = int(k);
-  const float r = ((x - k * 1.5703125f) - k * 4.837512969970703125e-4f) - k * 7.54978995489188216e-8f;
+  const float r =
+      ((x - k * 1.5703125f) - k * 4.837512969970703125e-4f) - k * 7.54978995489188216e-8f;
   const float z = r * r;
   const float sp = r + r * z * (-1.6666654611e-1f + z * (8.3321608736e-3f + z * -1.9515295891e-4f));
   const float cp =
@@ -52,10 +62,18 @@ inline void sincos_f(float x, float& s, float& c) {
 struct V3f {
   float x, y, z;
 };
-inline V3f operator+(V3f a, V3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3f operator-(V3f a, V3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3f operator*(float s, V3f a) { return {s * a.x, s * a.y, s * a.z}; }
-inline float dot(V3f a, V3f b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline V3f operator+(V3f a, V3f b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+inline V3f operator-(V3f a, V3f b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+inline V3f operator*(float s, V3f a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+inline float dot(V3f a, V3f b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 inline V3f cross(V3f a, V3f b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
@@ -63,8 +81,12 @@ inline V3f mul(const float* m, V3f v) {  // row-major 3x3
   return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[3] * v.x + m[4] * v.y + m[5] * v.z,
           m[6] * v.x + m[7] * v.y + m[8] * v.z};
 }
-inline Vec3 to_d(V3f v) { return Vec3(v.x, v.y, v.z); }
-inline V3f to_f(const Vec3& v) { return {float(v.x()), float(v.y()), float(v.z())}; }
+inline Vec3 to_d(V3f v) {
+  return Vec3(v.x, v.y, v.z);
+}
+inline V3f to_f(const Vec3& v) {
+  return {float(v.x()), float(v.y()), float(v.z())};
+}
 
 // Direction and its two partial derivatives (head frame) of a segment with polar frame (X, Y, Z).
 struct SegTrig {
@@ -88,8 +110,10 @@ struct StepArgs {
   const float *len = nullptr, *gain = nullptr, *pen = nullptr, *kt = nullptr, *kp = nullptr,
               *gd = nullptr, *th0 = nullptr, *ph0 = nullptr;
   const float *fy[3] = {nullptr, nullptr, nullptr}, *fz[3] = {nullptr, nullptr, nullptr};
-  const float *root[3] = {nullptr, nullptr, nullptr};
+  const float* root[3] = {nullptr, nullptr, nullptr};
   double *TH = nullptr, *PH = nullptr, *WT = nullptr, *WP = nullptr;
+  float* cdist = nullptr;
+  Vec3f* cnorm = nullptr;
   Vec3* nodes = nullptr;
   int substeps = 1;
   double h = 0;
@@ -187,7 +211,7 @@ struct Scratch {
   float ndx[kChunk], ndy[kChunk], ndz[kChunk];
   float netx[kChunk], nety[kChunk], netz[kChunk], nepx[kChunk], nepy[kChunk], nepz[kChunk];
   float vmax2[kChunk], nan[kChunk];  // largest squared node speed; NaN/Inf accumulator
-  int flag[kChunk];                   // candidates for the collision tests
+  int flag[kChunk];                  // candidates for the collision tests
 };
 
 // One block of strands [s0, s1) for params.substeps sub-steps. Layout [segment][strand]: the
@@ -201,9 +225,15 @@ struct Scratch {
 //   Phase B (state at t + h): new direction and node, the projection (ours), the second half
 //     kick of the uniform field with the new direction.
 // Rows beyond a short strand's tip are inert (zero length, zero gains): computed, unchanged.
-__attribute__((target_clones("avx2", "default"))) void step_block(
-    const StepArgs& a, std::size_t s0, std::size_t s1, sim::StepReport& rep,
-    std::size_t& unresolved, Scratch& S) {
+// Compiled for plain x86-64 and for AVX2 (twice the lanes, the same IEEE operations lane by lane:
+// avx2 does not enable FMA contraction), picked at load time by the CPU.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FOLLICLE_HINGE_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define FOLLICLE_HINGE_CLONES
+#endif
+FOLLICLE_HINGE_CLONES void step_block(const StepArgs& a, std::size_t s0, std::size_t s1,
+                                      sim::StepReport& rep, std::size_t& unresolved, Scratch& S) {
   const std::size_t n = s1 - s0, N = a.N, K = a.K;
   for (std::size_t j = 0; j < n; ++j) {
     S.vmax2[j] = 0.0f;
@@ -224,13 +254,13 @@ __attribute__((target_clones("avx2", "default"))) void step_block(
     for (std::size_t i = 0; i < K; ++i) {
       const std::size_t base = i * N + s0;
       const float* __restrict len = a.len + base;
-      const float *__restrict fy0 = a.fy[0] + base, *__restrict fy1 = a.fy[1] + base,
-                  *__restrict fy2 = a.fy[2] + base;
-      const float *__restrict fz0 = a.fz[0] + base, *__restrict fz1 = a.fz[1] + base,
-                  *__restrict fz2 = a.fz[2] + base;
-      double *__restrict TH = a.TH + base, *__restrict PH = a.PH + base;
-      double *__restrict WT = a.WT + base, *__restrict WP = a.WP + base;
-      // ---- Phase A: the configuration at t (vectorised).
+      const float* __restrict fy0 = a.fy[0] + base, * __restrict fy1 = a.fy[1] + base, * __restrict fy2 = a.fy[2] + base;
+      const float* __restrict fz0 = a.fz[0] + base, * __restrict fz1 = a.fz[1] + base, * __restrict fz2 = a.fz[2] + base;
+      double* __restrict TH = a.TH + base, * __restrict PH = a.PH + base;
+      double* __restrict WT = a.WT + base, * __restrict WP = a.WP + base;
+      // ---- Phase A: the configuration at t (vectorised). `ivdep`: the scratch rows, the state
+      // rows and the solver's rows never overlap (GCC 12 otherwise gives up on these loops).
+#pragma GCC ivdep
       for (std::size_t j = 0; j < n; ++j) {
         const float l = len[j];
         const V3f Y{fy0[j], fy1[j], fy2[j]}, Z{fz0[j], fz1[j], fz2[j]};
@@ -273,13 +303,23 @@ __attribute__((target_clones("avx2", "default"))) void step_block(
         S.pt[j] = S.pp[j] = S.Kt[j] = S.Kp[j] = S.Ct[j] = S.Cp[j] = 0.0f;
       }
       // ---- The reaction constraint (4)-(6) at the end nodes in contact (scalar).
+      // The contacts found at the end of the previous (sub-)step, where the nodes are now (up to
+      // the rounding of a projection); NaN (a fresh state): tested here.
       if (a.body) {
-        for (std::size_t j = 0; j < n; ++j) S.flag[j] = 0;
-        a.body->mark_candidates(S.Px, S.Py, S.Pz, n, a.contact, S.flag);
+        const float* __restrict cdist = a.cdist + base;
+        const Vec3f* __restrict cnorm = a.cnorm + base;
         for (std::size_t j = 0; j < n; ++j) {
-          if (!S.flag[j] || !(len[j] > 0.0f)) continue;
+          if (!(cdist[j] <= 1e30f) && !std::isnan(cdist[j])) continue;  // +inf: not near
+          if (!(len[j] > 0.0f)) continue;
           sim::CylinderContactF cc;
-          if (a.body->contact(S.Px[j], S.Py[j], S.Pz[j], a.contact, cc) < 0) continue;
+          if (std::isnan(cdist[j])) {
+            if (a.body->contact(S.Px[j], S.Py[j], S.Pz[j], a.contact, cc) < 0) continue;
+          } else {
+            cc.distance = cdist[j];
+            cc.nx = cnorm[j].x();
+            cc.ny = cnorm[j].y();
+            cc.nz = cnorm[j].z();
+          }
           const V3f Nv{cc.nx, cc.ny, cc.nz};
           const V3f et{S.etx[j], S.ety[j], S.etz[j]}, ep{S.epx[j], S.epy[j], S.epz[j]};
           const V3f Fin = V3f{S.fx[j], S.fy[j], S.fz[j]} + b;  // F_input: every force on s_i
@@ -313,9 +353,9 @@ __attribute__((target_clones("avx2", "default"))) void step_block(
       }
       // ---- Kick, hinge oscillator, Phase B (vectorised).
       {
-        const float *__restrict gain = a.gain + base, *__restrict kt = a.kt + base,
-                    *__restrict kp = a.kp + base, *__restrict gd = a.gd + base;
-        const float *__restrict th0 = a.th0 + base, *__restrict ph0 = a.ph0 + base;
+        const float* __restrict gain = a.gain + base, * __restrict kt = a.kt + base, * __restrict kp = a.kp + base, * __restrict gd = a.gd + base;
+        const float* __restrict th0 = a.th0 + base, * __restrict ph0 = a.ph0 + base;
+#pragma GCC ivdep
         for (std::size_t j = 0; j < n; ++j) {
           // (2) external moments per unit inertia; kick.
           double wt = WT[j] + h * double(gain[j] * (S.ft[j] + S.bs[j] * S.bt[j]) + S.pt[j]);
@@ -325,11 +365,14 @@ __attribute__((target_clones("avx2", "default"))) void step_block(
           //   q' = q + h (ω + ω')/2,
           // with the linearised (5) added to k and γ.
           const double ktj = kt[j], kpj = kp[j], gdj = gd[j];
-          const double sig_t = 0.5 * h * (gdj + double(S.Ct[j]) + 0.5 * h * (ktj + double(S.Kt[j])));
-          const double sig_p = 0.5 * h * (gdj + double(S.Cp[j]) + 0.5 * h * (kpj + double(S.Kp[j])));
+          const double sig_t =
+              0.5 * h * (gdj + double(S.Ct[j]) + 0.5 * h * (ktj + double(S.Kt[j])));
+          const double sig_p =
+              0.5 * h * (gdj + double(S.Cp[j]) + 0.5 * h * (kpj + double(S.Kp[j])));
           const double th = TH[j], ph = PH[j];
-          const double wt1 = ((1.0 - sig_t) * wt - h * ktj * (th - double(th0[j]))) / (1.0 + sig_t);
-          const double wp1 = ((1.0 - sig_p) * wp - h * kpj * (ph - double(ph0[j]))) / (1.0 + sig_p);
+          const double dth = wrap_pi(th - double(th0[j])), dph = wrap_pi(ph - double(ph0[j]));
+          const double wt1 = ((1.0 - sig_t) * wt - h * ktj * dth) / (1.0 + sig_t);
+          const double wp1 = ((1.0 - sig_p) * wp - h * kpj * dph) / (1.0 + sig_p);
           const double thn = th + 0.5 * h * (wt + wt1), phn = ph + 0.5 * h * (wp + wp1);
           TH[j] = thn;
           PH[j] = phn;
@@ -356,15 +399,23 @@ __attribute__((target_clones("avx2", "default"))) void step_block(
           S.Qz[j] = S.Bz[j] + l * e.d.z;
         }
       }
-      // ---- Ours: end nodes still inside are turned about B onto the surface (scalar).
-      if (a.project) {
+      // ---- Nodes near the body for the next step; ours: end nodes still inside are turned
+      // about B onto the surface (scalar).
+      if (a.body) {
+        float* __restrict cdist = a.cdist + base;
+        Vec3f* __restrict cnorm = a.cnorm + base;
         for (std::size_t j = 0; j < n; ++j) S.flag[j] = 0;
-        a.body->mark_candidates(S.Qx, S.Qy, S.Qz, n, 0.0f, S.flag);
+        a.body->mark_candidates(S.Qx, S.Qy, S.Qz, n, a.contact, S.flag);
         for (std::size_t j = 0; j < n; ++j) {
+          cdist[j] = std::numeric_limits<float>::infinity();
           const float l = len[j];
           if (!S.flag[j] || !(l > 0.0f)) continue;
           sim::CylinderContactF cc;
-          if (a.body->contact(S.Qx[j], S.Qy[j], S.Qz[j], 0.0f, cc) < 0) continue;
+          if (a.body->contact(S.Qx[j], S.Qy[j], S.Qz[j], a.contact, cc) < 0) continue;
+          // Near the body; a node put back onto the surface below is in contact there (PT = 0).
+          cdist[j] = a.project ? std::max(cc.distance, 0.0f) : cc.distance;
+          cnorm[j] = Vec3f(cc.nx, cc.ny, cc.nz);
+          if (!a.project || !(cc.depth_radial > 0.0f)) continue;  // not inside the surface
           const std::size_t idx = base + j;
           const V3f Y{a.fy[0][idx], a.fy[1][idx], a.fy[2][idx]};
           const V3f Z{a.fz[0][idx], a.fz[1][idx], a.fz[2][idx]};
@@ -384,19 +435,28 @@ __attribute__((target_clones("avx2", "default"))) void step_block(
           th2 += 2.0 * kPi * std::round((th - th2) / (2.0 * kPi));
           th = th2;
           ph = ph2;
-          const SegTrig e = seg_trig(float(std::sin(th)), float(std::cos(th)),
-                                     float(std::sin(ph)), float(std::cos(ph)), X, Y, Z);
+          const SegTrig e = seg_trig(float(std::sin(th)), float(std::cos(th)), float(std::sin(ph)),
+                                     float(std::cos(ph)), X, Y, Z);
           const Vec3 Qd = Bd + double(l) * dn;
-          // Inelastic: drop the inward normal velocity of the end node.
+          // Inelastic: drop the inward normal velocity v_n of the end node with the smallest
+          // change of (θ', φ') (the metric of (1)): Δω = -v_n Jᵀ N / |Jᵀ N|², J = l (∂d/∂θ,
+          // ∂d/∂φ); never adding kinetic energy. (Dividing by |∂d/∂φ|² instead would blow up
+          // near a pole of the polar frame.)
           const Vec3 et = to_d(e.et), ep = to_d(e.ep);
           double wt = WT[j], wp = WP[j];
           const Vec3 vB(S.Bvx[j], S.Bvy[j], S.Bvz[j]);
           const double vn = (vB + double(l) * (wt * et + wp * ep)).dot(Nd);
-          if (vn < 0.0) {
-            const Vec3 dv = -vn * Nd;
-            wt += dv.dot(et) / double(l);
-            const double ep2 = ep.squaredNorm();
-            if (ep2 > 1e-6) wp += dv.dot(ep) / (double(l) * ep2);
+          const double jt = double(l) * et.dot(Nd), jp = double(l) * ep.dot(Nd);
+          const double jj = jt * jt + jp * jp;
+          if (vn < 0.0 && jj > 1e-8 * double(l) * double(l)) {
+            const double w0 = std::hypot(wt, wp);
+            wt -= vn * jt / jj;
+            wp -= vn * jp / jj;
+            const double w1 = std::hypot(wt, wp);
+            if (w1 > w0) {
+              wt *= w0 / w1;
+              wp *= w0 / w1;
+            }
           }
           TH[j] = th;
           PH[j] = ph;
@@ -416,6 +476,7 @@ __attribute__((target_clones("avx2", "default"))) void step_block(
       // ---- Second half kick of the uniform field at t + h; speeds; next row (vectorised).
       {
         const float* __restrict gain = a.gain + base;
+#pragma GCC ivdep
         for (std::size_t j = 0; j < n; ++j) {
           const V3f et{S.netx[j], S.nety[j], S.netz[j]}, ep{S.nepx[j], S.nepy[j], S.nepz[j]};
           const float gb = gain[j] * S.be[j];
@@ -481,7 +542,8 @@ HingeSolver::HingeSolver(const HingeParams& params, const geom::StrandSet& rest,
   m_mu = m_p.density * kPi * m_p.radius * m_p.radius;
   const std::size_t K = std::size_t(m_k), N = m_n, KN = K * N;
   m_nseg.resize(N);
-  for (auto* v : {&m_len_d, &m_arm_d, &m_inertia_d, &m_kt_d, &m_kp_d, &m_gamma_d}) v->assign(KN, 0.0);
+  for (auto* v : {&m_len_d, &m_arm_d, &m_inertia_d, &m_kt_d, &m_kp_d, &m_gamma_d})
+    v->assign(KN, 0.0);
   for (auto* v : {&m_theta0, &m_phi0, &m_len, &m_gain, &m_pen, &m_kt, &m_kp, &m_gd})
     v->assign(KN, 0.0f);
   for (int c = 0; c < 3; ++c) {
@@ -564,15 +626,26 @@ HingeSolver::HingeSolver(const HingeParams& params, const geom::StrandSet& rest,
   }
 }
 
-double HingeSolver::inertia(std::size_t s, int i) const { return m_inertia_d[row(s, i)]; }
-double HingeSolver::k_theta(std::size_t s, int i) const { return m_kt_d[row(s, i)]; }
-double HingeSolver::k_phi(std::size_t s, int i) const { return m_kp_d[row(s, i)]; }
-double HingeSolver::damping(std::size_t s, int i) const { return m_gamma_d[row(s, i)]; }
-double HingeSolver::arm(std::size_t s, int i) const { return m_arm_d[row(s, i)]; }
+double HingeSolver::inertia(std::size_t s, int i) const {
+  return m_inertia_d[row(s, i)];
+}
+double HingeSolver::k_theta(std::size_t s, int i) const {
+  return m_kt_d[row(s, i)];
+}
+double HingeSolver::k_phi(std::size_t s, int i) const {
+  return m_kp_d[row(s, i)];
+}
+double HingeSolver::damping(std::size_t s, int i) const {
+  return m_gamma_d[row(s, i)];
+}
+double HingeSolver::arm(std::size_t s, int i) const {
+  return m_arm_d[row(s, i)];
+}
 
 Vec3 HingeSolver::direction(std::size_t s, int i, double theta, double phi) const {
   const std::size_t idx = row(s, i);
-  const Vec3 Y(m_fy[0][idx], m_fy[1][idx], m_fy[2][idx]), Z(m_fz[0][idx], m_fz[1][idx], m_fz[2][idx]);
+  const Vec3 Y(m_fy[0][idx], m_fy[1][idx], m_fy[2][idx]),
+      Z(m_fz[0][idx], m_fz[1][idx], m_fz[2][idx]);
   const Vec3 X = Y.cross(Z);
   const Vec3 dl = segment_direction(theta, phi);
   return dl.x() * X + dl.y() * Y + dl.z() * Z;
@@ -581,7 +654,8 @@ Vec3 HingeSolver::direction(std::size_t s, int i, double theta, double phi) cons
 void HingeSolver::angles(std::size_t s, int i, const Vec3& dir, double phi_hint, double& theta,
                          double& phi) const {
   const std::size_t idx = row(s, i);
-  const Vec3 Y(m_fy[0][idx], m_fy[1][idx], m_fy[2][idx]), Z(m_fz[0][idx], m_fz[1][idx], m_fz[2][idx]);
+  const Vec3 Y(m_fy[0][idx], m_fy[1][idx], m_fy[2][idx]),
+      Z(m_fz[0][idx], m_fz[1][idx], m_fz[2][idx]);
   const Vec3 X = Y.cross(Z);
   direction_angles(Vec3(dir.dot(X), dir.dot(Y), dir.dot(Z)), phi_hint, theta, phi);
 }
@@ -594,6 +668,8 @@ HingeState HingeSolver::initial_state() const {
   st.dtheta.assign(KN, 0.0);
   st.dphi.assign(KN, 0.0);
   st.nodes.assign(std::size_t(m_k + 1) * N, Vec3::Zero());
+  st.contact_distance.assign(KN, std::numeric_limits<float>::quiet_NaN());
+  st.contact_normal.assign(KN, Vec3f::Zero());
   for (std::size_t s = 0; s < N; ++s) {
     const uint32_t b = m_rest.offsets[s];
     for (int i = 0; i <= m_k; ++i)
@@ -606,9 +682,10 @@ sim::StepReport HingeSolver::step(const Context& ctx, const HingeInput& in, Hing
   const std::size_t N = m_n, K = std::size_t(m_k);
   if (st.theta.size() != K * N || st.phi.size() != K * N || st.dtheta.size() != K * N ||
       st.dphi.size() != K * N || st.nodes.size() != (K + 1) * N)
-    fail("hinge solver: state has the wrong size (expected {} angles and {} nodes); use "
-         "initial_state()",
-         K * N, (K + 1) * N);
+    fail(
+        "hinge solver: state has the wrong size (expected {} angles and {} nodes); use "
+        "initial_state()",
+        K * N, (K + 1) * N);
   const double h = m_p.dt / m_p.substeps;
   const Mat3 RT = in.head.rotation.normalized().toRotationMatrix().transpose();
   // Head-frame fields: the uniform part b (gravity and the frame's linear acceleration), the
@@ -644,6 +721,11 @@ sim::StepReport HingeSolver::step(const Context& ctx, const HingeInput& in, Hing
   a.WT = st.dtheta.data();
   a.WP = st.dphi.data();
   a.nodes = st.nodes.data();
+  if (st.contact_distance.size() != K * N)  // (a hand-made state)
+    st.contact_distance.assign(K * N, std::numeric_limits<float>::quiet_NaN());
+  if (st.contact_normal.size() != K * N) st.contact_normal.assign(K * N, Vec3f::Zero());
+  a.cdist = st.contact_distance.data();
+  a.cnorm = st.contact_normal.data();
   a.substeps = m_p.substeps;
   a.h = h;
   a.hf = float(h);
@@ -709,8 +791,8 @@ double HingeSolver::potential_energy(const HingeState& st, const HingeInput& in)
     for (int i = 1; i <= m_nseg[s]; ++i) {
       const std::size_t idx = row(s, i);
       if (!(m_len_d[idx] > 1e-9)) continue;
-      const double dt = st.theta[idx] - double(m_theta0[idx]);
-      const double dp = st.phi[idx] - double(m_phi0[idx]);
+      const double dt = wrap_pi(st.theta[idx] - double(m_theta0[idx]));
+      const double dp = wrap_pi(st.phi[idx] - double(m_phi0[idx]));
       const double a = m_arm_d[idx];
       e += 0.5 * m_kt_d[idx] * dt * dt + 0.5 * m_kp_d[idx] * dp * dp -
            m_mu * a * (0.5 * a) * g.dot(direction(s, i, st.theta[idx], st.phi[idx]));

@@ -50,29 +50,34 @@
 namespace follicle::hair {
 
 struct HingeParams {
-  double dt = 1.0 / 240.0;  // [s] step() advances by dt
-  int substeps = 1;         // integration sub-steps per step (h = dt / substeps)
+  double dt = 1.0 / 240.0;           // [s] step() advances by dt
+  int substeps = 1;                  // integration sub-steps per step (h = dt / substeps)
   std::string polar_frame = "rest";  // "rest" (styled direction on the equator) | "head"
-  std::string inertia = "outboard";  // "outboard" (hinge carries the rest of the strand) | "segment"
-  double inertia_scale = 1.0;        // multiplies every I_i (the paper's user parameter)
-  double density = 1300.0;           // [kg/m³] hair (keratin)
-  double radius = 40e-6;             // [m] hair radius: μ = ρ π r² per unit length
+  std::string inertia =
+      "outboard";              // "outboard" (hinge carries the rest of the strand) | "segment"
+  double inertia_scale = 1.0;  // multiplies every I_i (the paper's user parameter)
+  double density = 1300.0;     // [kg/m³] hair (keratin)
+  double radius = 40e-6;       // [m] hair radius: μ = ρ π r² per unit length
   // Springs (3) and damping (1) for a lever arm of reference_length; an arm a (l_i or a_i, see
   // inertia) gets k (a / reference_length)² and γ (a / reference_length)^2.5, which keeps the
   // sag under gravity and the damping ratio independent of the segmentation (0 = no scaling).
-  double k_theta = 4e-9;           // [N·m/rad] k_θ at the root
-  double k_phi = 4e-9;             // [N·m/rad] k_φ at the root
-  double tip_stiffness = 1.0;      // k at the tip / k at the root (linear in arc length)
-  double damping = 1.3e-11;        // [N·m·s/rad] γ (damping ratio ≈ 0.2 at the defaults)
+  // Defaults: a horizontal styled segment sags about 26° under gravity (k ≈ 1.9 m g a/2 for the
+  // reference arm), damping ratio about 0.2 (γ = 0.4 sqrt(k I)), for hair of the default density
+  // and radius. Springs, damping and the penalty of (5) are implicit; the explicit kick of the
+  // external field needs dt < 2 sqrt(2 a / 3 g) (16 ms for an arm of 1 mm).
+  double k_theta = 1.5e-9;          // [N·m/rad] k_θ at the root
+  double k_phi = 1.5e-9;            // [N·m/rad] k_φ at the root
+  double tip_stiffness = 1.0;       // k at the tip / k at the root (linear in arc length)
+  double damping = 8e-12;           // [N·m·s/rad] γ
   double reference_length = 0.005;  // [m]
-  double drag = 5e-5;  // [N·s/m²] wind drag per unit length and unit relative speed
+  double drag = 5e-5;               // [N·s/m²] wind drag per unit length and unit relative speed
   // Reaction constraint (4)-(6), per unit mass of the segment's arm: F_constrained =
   // -(k PT + c V·N) N with PT = (P - T)·N (negative inside).
-  double collision_k = 1e4;           // [1/s²] strength k of (5)
-  double collision_c = 100.0;         // [1/s] damping c of (5)
-  double contact_distance = 0.001;    // [m] (4)-(6) act on nodes this close to the surface
-  bool projection = true;             // ours: put nodes still inside back onto the surface
-  double max_speed = 50.0;            // [m/s] blow-up limit (node speed in the head frame)
+  double collision_k = 1e4;         // [1/s²] strength k of (5)
+  double collision_c = 100.0;       // [1/s] damping c of (5)
+  double contact_distance = 0.001;  // [m] (4)-(6) act on nodes this close to the surface
+  bool projection = true;           // ours: put nodes still inside back onto the surface
+  double max_speed = 50.0;          // [m/s] blow-up limit (node speed in the head frame)
 
   template <class V>
   void visit(V&& v) {
@@ -87,15 +92,17 @@ struct HingeParams {
     v("inertia_scale", inertia_scale, {"multiplier of every moment of inertia", "", 1e-3, 1e6});
     v("density", density, {"hair density", "kg/m^3", 1.0, 1e5});
     v("radius", radius, {"hair radius", "m", 1e-7, 0.01});
-    v("k_theta", k_theta, {"spring constant k_theta at the root (reference arm)", "N*m/rad", 0.0, 1.0});
+    v("k_theta", k_theta,
+      {"spring constant k_theta at the root (reference arm)", "N*m/rad", 0.0, 1.0});
     v("k_phi", k_phi, {"spring constant k_phi at the root (reference arm)", "N*m/rad", 0.0, 1.0});
     v("tip_stiffness", tip_stiffness, {"spring constant at the tip / at the root", "", 0.0, 1e3});
     v("damping", damping, {"damping gamma (reference arm)", "N*m*s/rad", 0.0, 1.0});
     v("reference_length", reference_length,
-      {"arm length the spring and damping constants are given for (0: no scaling)", "m", 0.0, 10.0});
+      {"arm length the spring and damping constants are given for (0: no scaling)", "m", 0.0,
+       10.0});
     v("drag", drag, {"wind drag per unit length and relative speed", "N*s/m^2", 0.0, 1.0});
-    v("collision_k", collision_k, {"strength k of the reaction constraint (5), per unit mass",
-                                   "1/s^2", 0.0, 1e9});
+    v("collision_k", collision_k,
+      {"strength k of the reaction constraint (5), per unit mass", "1/s^2", 0.0, 1e9});
     v("collision_c", collision_c,
       {"damping c of the reaction constraint (5), per unit mass", "1/s", 0.0, 1e6});
     v("contact_distance", contact_distance,
@@ -108,7 +115,7 @@ struct HingeParams {
 };
 
 struct HingeInput {
-  Vec3 gravity{0.0, -9.81, 0.0};     // [m/s²] world
+  Vec3 gravity{0.0, -9.81, 0.0};      // [m/s²] world
   Vec3 wind_velocity = Vec3::Zero();  // [m/s] world: uniform air velocity
   HeadMotion head;                    // rigid head motion (world), see projective_anjyo1992.hpp
 };
@@ -122,6 +129,13 @@ struct HingeState {
   double time = 0.0;
   uint64_t step = 0;
   std::size_t unresolved = 0;  // nodes the last step could not move out of the body (0 normally)
+  // Contacts found at the end of the last step, [segment][strand] for the segment's end node:
+  // (P - T)·N of (5) where the node is within contact_distance of the body, +inf elsewhere, and
+  // the normal N there. The next step applies the reaction constraint (4)-(6) from these (its
+  // nodes start where the last step left them). initial_state: NaN = "not known, test every
+  // node"; a state edited by hand should be reset to NaN.
+  std::vector<float> contact_distance;
+  std::vector<Vec3f> contact_normal;
 };
 
 class HingeSolver {
@@ -181,7 +195,7 @@ class HingeSolver {
   std::vector<float> m_theta0, m_phi0;  // styled angles (the state starts at exactly these)
   std::vector<float> m_len;             // l_i
   std::vector<float> m_gain;            // 3 / (2 a_i s): angular acceleration per unit field
-  std::vector<float> m_pen;             // 3 l_i / (a_i² s): same for a force per unit arm mass at P_i
+  std::vector<float> m_pen;  // 3 l_i / (a_i² s): same for a force per unit arm mass at P_i
   std::vector<float> m_kt, m_kp, m_gd;  // k_θ / I, k_φ / I, (γ + drag of the arm's own turn) / I
   std::vector<float> m_fy[3], m_fz[3];  // polar frame: pole (local y) and equator zero (local z)
   std::vector<float> m_root[3];         // [N] roots, head frame

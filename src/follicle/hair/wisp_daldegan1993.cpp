@@ -30,8 +30,7 @@ class RootGrid {
     const double area = std::max({ext.x() * ext.y(), ext.y() * ext.z(), ext.z() * ext.x(),
                                   ext.maxCoeff() * ext.maxCoeff() * 1e-6, 1e-18});
     m_h = std::max(std::sqrt(2.0 * area / double(pts.size())), 1e-9);
-    for (int c = 0; c < 3; ++c)
-      m_dim[c] = std::clamp(int(ext[c] / m_h) + 1, 1, 1024);
+    for (int c = 0; c < 3; ++c) m_dim[c] = std::clamp(int(ext[c] / m_h) + 1, 1, 1024);
     for (int c = 0; c < 3; ++c) m_h = std::max(m_h, ext[c] / m_dim[c] * (1 + 1e-9));
     const std::size_t cells = std::size_t(m_dim[0]) * std::size_t(m_dim[1]) * std::size_t(m_dim[2]);
     m_start.assign(cells + 1, 0);
@@ -43,29 +42,37 @@ class RootGrid {
     for (std::size_t c = 0; c < cells; ++c) m_start[c + 1] += m_start[c];
     m_items.resize(pts.size());
     std::vector<uint32_t> fill(m_start.begin(), m_start.end() - 1);
-    for (std::size_t i = 0; i < pts.size(); ++i) m_items[fill[cell_of[i]]++] = uint32_t(i);  // stable
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      m_items[fill[cell_of[i]]++] = uint32_t(i);  // stable
   }
 
   // Nearest point to q (ties: lowest index).
   uint32_t nearest(const Vec3& q) const {
-    Eigen::Vector3i qc;
-    for (int c = 0; c < 3; ++c) qc[c] = int(std::floor((q[c] - m_lo[c]) / m_h));
+    long long qc[3], dim[3];
+    for (int c = 0; c < 3; ++c) {
+      qc[c] = (long long)std::clamp(std::floor((q[c] - m_lo[c]) / m_h), -1e12, 1e12);
+      dim[c] = m_dim[c];
+    }
+    // Rings of Chebyshev radius r around q's (possibly outside) cell, from the first that meets
+    // the grid; after ring r every point not yet seen is farther than r h from q.
+    long long r0 = 0, rmax = 0;
+    for (int c = 0; c < 3; ++c) {
+      r0 = std::max({r0, -qc[c], qc[c] - (dim[c] - 1)});
+      rmax = std::max({rmax, std::abs(qc[c]), std::abs(qc[c] - (dim[c] - 1))});
+    }
     double best = std::numeric_limits<double>::infinity();
     uint32_t best_i = 0;
-    // Rings of Chebyshev radius r around q's (possibly outside) cell; after ring r every point
-    // not yet seen is farther than r h from q.
-    int rmax = 0;
-    for (int c = 0; c < 3; ++c)
-      rmax = std::max({rmax, std::abs(qc[c]), std::abs(qc[c] - (m_dim[c] - 1))});
-    for (int r = 0; r <= rmax; ++r) {
-      for (int z = qc[2] - r; z <= qc[2] + r; ++z) {
-        if (z < 0 || z >= m_dim[2]) continue;
-        for (int y = qc[1] - r; y <= qc[1] + r; ++y) {
-          if (y < 0 || y >= m_dim[1]) continue;
-          const bool shell_zy = std::abs(z - qc[2]) == r || std::abs(y - qc[1]) == r;
-          for (int x = qc[0] - r; x <= qc[0] + r; x += (shell_zy ? 1 : std::max(1, 2 * r))) {
-            if (x < 0 || x >= m_dim[0]) continue;
-            const std::size_t cell = cell_index(Eigen::Vector3i(x, y, z));
+    for (long long r = r0; r <= rmax; ++r) {
+      const long long z0 = std::max(0LL, qc[2] - r), z1 = std::min(dim[2] - 1, qc[2] + r);
+      const long long y0 = std::max(0LL, qc[1] - r), y1 = std::min(dim[1] - 1, qc[1] + r);
+      for (long long z = z0; z <= z1; ++z)
+        for (long long y = y0; y <= y1; ++y) {
+          const bool shell_zy = std::llabs(z - qc[2]) == r || std::llabs(y - qc[1]) == r;
+          // Cells of the ring in this (z, y) row: all of them on the shell, else the two ends.
+          const long long xs[2] = {qc[0] - r, qc[0] + r};
+          const long long x0 = std::max(0LL, qc[0] - r), x1 = std::min(dim[0] - 1, qc[0] + r);
+          auto scan = [&](long long x) {
+            const std::size_t cell = cell_index(Eigen::Vector3i(int(x), int(y), int(z)));
             for (std::size_t k = m_start[cell]; k < m_start[cell + 1]; ++k) {
               const uint32_t i = m_items[k];
               const double d = (m_pts[i] - q).squaredNorm();
@@ -74,9 +81,14 @@ class RootGrid {
                 best_i = i;
               }
             }
+          };
+          if (shell_zy) {
+            for (long long x = x0; x <= x1; ++x) scan(x);
+          } else {
+            for (int e = 0; e < (r > 0 ? 2 : 1); ++e)
+              if (xs[e] >= 0 && xs[e] < dim[0]) scan(xs[e]);
           }
         }
-      }
       if (best <= (double(r) * m_h) * (double(r) * m_h)) break;
     }
     return best_i;
@@ -197,8 +209,10 @@ void apply_impl(const WispBinding& b, const geom::StrandSet& grest, const geom::
       } else {
         const double u0 = b.guide_u[gb + k], u1 = b.guide_u[gb + k + 1];
         const double w = u1 > u0 ? std::clamp((double(u) - u0) / (u1 - u0), 0.0, 1.0) : 0.0;
-        now = (1 - w) * gnow.points[gb + k].cast<double>() + w * gnow.points[gb + k + 1].cast<double>();
-        rest = (1 - w) * grest.points[gb + k].cast<double>() + w * grest.points[gb + k + 1].cast<double>();
+        now = (1 - w) * gnow.points[gb + k].cast<double>() +
+              w * gnow.points[gb + k + 1].cast<double>();
+        rest = (1 - w) * grest.points[gb + k].cast<double>() +
+               w * grest.points[gb + k + 1].cast<double>();
       }
       if (b.paper) {
         out.points[fb + j] = (now + shift).cast<float>();
@@ -225,9 +239,8 @@ WispBinding bind_wisps(const geom::StrandSet& guides_rest, const geom::StrandSet
 
 WispBinding bind_wisps(const Context& ctx, const geom::StrandSet& guides_rest,
                        const geom::StrandSet& full_rest, const WispParams& params) {
-  return bind_impl(guides_rest, full_rest, params, [&](std::size_t n, const auto& f) {
-    parallel_for(ctx, 0, n, f, 512);
-  });
+  return bind_impl(guides_rest, full_rest, params,
+                   [&](std::size_t n, const auto& f) { parallel_for(ctx, 0, n, f, 512); });
 }
 
 void apply_wisps(const WispBinding& binding, const geom::StrandSet& guides_rest,
@@ -242,9 +255,9 @@ void apply_wisps(const WispBinding& binding, const geom::StrandSet& guides_rest,
   apply_impl(binding, guides_rest, guides_now, head.rotation, full_out, serial);
 }
 
-void apply_wisps(const Context& ctx, const WispBinding& binding,
-                 const geom::StrandSet& guides_rest, const geom::StrandSet& guides_now,
-                 const Quat& head_rotation, geom::StrandSet& full_out) {
+void apply_wisps(const Context& ctx, const WispBinding& binding, const geom::StrandSet& guides_rest,
+                 const geom::StrandSet& guides_now, const Quat& head_rotation,
+                 geom::StrandSet& full_out) {
   apply_impl(binding, guides_rest, guides_now, head_rotation, full_out,
              [&](std::size_t n, const auto& f) { parallel_for(ctx, 0, n, f, 256); });
 }

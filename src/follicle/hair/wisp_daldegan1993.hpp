@@ -46,13 +46,13 @@ struct WispParams {
 /// What apply_wisps needs, precomputed from the rest strands.
 struct WispBinding {
   bool paper = false;
-  std::vector<uint32_t> guide;          // [followers] index of the guide
-  std::vector<uint32_t> offsets{0};     // followers' layout (copy of the full hair's offsets)
-  std::vector<Vec3f> rest;              // [follower points] rest positions ("offset" mode)
-  std::vector<float> u;                 // [follower points] rest arc-length fraction
-  std::vector<Vec3f> shift;             // [followers] root offset + jitter ("paper" mode)
+  std::vector<uint32_t> guide;             // [followers] index of the guide
+  std::vector<uint32_t> offsets{0};        // followers' layout (copy of the full hair's offsets)
+  std::vector<Vec3f> rest;                 // [follower points] rest positions ("offset" mode)
+  std::vector<float> u;                    // [follower points] rest arc-length fraction
+  std::vector<Vec3f> shift;                // [followers] root offset + jitter ("paper" mode)
   std::vector<uint32_t> guide_offsets{0};  // guides' layout (checked in apply_wisps)
-  std::vector<float> guide_u;           // [guide points] rest arc-length fraction
+  std::vector<float> guide_u;              // [guide points] rest arc-length fraction
 
   std::size_t num_followers() const { return guide.size(); }
   std::size_t num_guides() const { return guide_offsets.size() - 1; }

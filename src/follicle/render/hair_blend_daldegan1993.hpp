@@ -73,12 +73,14 @@ struct ShadowBuffer {
   void check(const std::string& where) const;
 };
 
-/// Step (2): the casting strands' segments drawn into a Z-buffer seen from the light: every
-/// texel whose square meets a segment (widened by its radius, if any; conservatively, so a
-/// hair thinner than a texel leaves no gaps) keeps the smallest depth of the segments there,
-/// the depth of the segment's point nearest the texel centre. Parallel over bands of rows; the
-/// result does not depend on the thread count. Throws follicle::Error for bad hair (check()),
-/// a size outside [1, 16384] or a light_vp that is not a finite orthographic projection.
+/// Step (2): the casting strands' segments drawn into a Z-buffer seen from the light, each texel
+/// keeping the smallest depth of the segments there. Conservative, so that a hair thinner than
+/// a texel leaves no gaps: without radii, every texel the segment passes through (a grid walk,
+/// Amanatides & Woo 1987) with the segment's nearest depth inside it; with radii, every texel
+/// whose square meets the segment widened by its radius, with the depth of the segment's point
+/// nearest the texel centre. Parallel over bands of rows; the result does not depend on the
+/// thread count. Throws follicle::Error for bad hair (check()), a size outside [1, 16384] or a
+/// light_vp that is not a finite orthographic projection.
 ShadowBuffer rasterize_hair_depth(const Context& ctx, const HairSegments& hair,
                                   const Mat4& light_vp, int size);
 
@@ -171,10 +173,11 @@ void shade_hair_vertices(const Context& ctx, const HairSegments& hair, std::size
 /// (x0 + x, y0 + y).
 struct HairFrame {
   int fb_width = 0, fb_height = 0;            // full framebuffer (the viewport) [px]
-  int x0 = 0, y0 = 0, width = 0, height = 0;  // the window
+  int x0 = 0, y0 = 0, width = 0, height = 0;  // the window (multiples of `samples`)
   float* rgba = nullptr;         // linear RGBA floats of the window, rows rgba_stride apart
   int rgba_stride = 0;           // pixels from one row to the next; 0: width
   const float* depth = nullptr;  // width * height window depths in [0, 1] (the scene Z)
+  int samples = 1;               // k of a k-times supersampled framebuffer (see HairBlender)
 };
 
 /// Step (5), blending (LeBlanc et al. 1991 pixel blending). Each segment is an antialiased line
@@ -192,19 +195,26 @@ struct HairFrame {
 /// a segment over such pixels, or behind the scene there, is skipped whole (up to 1/4096 of a
 /// hidden hair's colour is lost).
 /// Depth order: the depth of the segment's midpoint; ties: the first in the input is in front.
-/// Rows are split into bands of 16 drawn in parallel: the segments are first copied band by
-/// band (in input order; a streaming pass), then every band sorts its own (stable radix sort)
-/// and draws them, so the image does not depend on the thread count and no band reads
-/// scattered memory. Segments are clipped at the near plane. prepare() projects and bins; the
-/// scratch memory is kept between frames.
+/// In a k-times supersampled framebuffer (HairFrame::samples = k) the hair is drawn per block
+/// of k x k pixels (a "cell", the output pixel): the analytic coverage of the cell is the mean
+/// of its k^2 pixels' coverages, so the resolved image keeps the same antialiasing at 1/k^2 of
+/// the work. A fragment nearer than all k^2 scene depths of its cell is drawn with its alpha,
+/// one behind all of them not at all, one in between (an object's edge) with its alpha times
+/// the share of the pixels it is in front of; the cell's hair is then composited over each of
+/// its k^2 pixels. Rows of cells are split into bands of 16 drawn in parallel: the segments are
+/// first copied band by band (in input order; a streaming pass), then every band sorts its own
+/// (stable radix sort) and draws them, so the image does not depend on the thread count and no
+/// band reads scattered memory. Segments are clipped at the near plane. prepare() projects and
+/// bins; the scratch memory is kept between frames.
 class HairBlender {
  public:
-  /// Projects the segments with `view_proj` into a fb_width x fb_height framebuffer and sorts
-  /// them. Throws follicle::Error for bad hair or a bad framebuffer size / matrix.
+  /// Projects the segments with `view_proj` into a fb_width x fb_height framebuffer of k =
+  /// `samples` supersampling (both sizes multiples of k) and bins them. Throws follicle::Error
+  /// for bad hair or a bad framebuffer size / matrix.
   void prepare(const Context& ctx, const Mat4& view_proj, const HairSegments& hair, int fb_width,
-               int fb_height);
-  /// The framebuffer pixels (x0, y0, x1, y1; half-open) the prepared segments can touch; all 0
-  /// when none is on screen.
+               int fb_height, int samples = 1);
+  /// The framebuffer pixels (x0, y0, x1, y1; half-open, multiples of k) the prepared segments
+  /// can touch; all 0 when none is on screen.
   std::array<int, 4> bounds() const { return m_bounds; }
   /// Blends the prepared segments (`hair` must be the one given to prepare()) with one colour
   /// per point into `target`. Throws follicle::Error for a target that does not fit the
@@ -212,11 +222,10 @@ class HairBlender {
   void blend(const Context& ctx, const HairSegments& hair, std::span<const Vec3f> colors,
              const HairFrame& target);
 
-  /// A point as the blend reads it: 32 bytes, so that a segment's two ends share one or two
-  /// cache lines.
+  /// A point as the blend reads it.
   struct alignas(32) Point {
-    float x, y, z;  // window position [px] and depth
-    float w_px;     // line width [px]; < 0: behind the near plane
+    float x, y, z;  // window position [cells] and depth
+    float w_px;     // line width [cells]; < 0: behind the near plane
     float r, g, b;  // colour (set by blend())
     float alpha;    // the strand's opacity
   };
@@ -234,14 +243,16 @@ class HairBlender {
   /// A band's draw order (one per thread, kept between frames).
   struct BandScratch {
     std::vector<uint64_t> order, tmp;  // (depth key << 32 | index in the band), near first
-    std::vector<float> acc;            // the band's hair: premultiplied RGB, alpha per pixel
-    std::vector<int> open;             // per block of columns: pixels not yet opaque
+    std::vector<float> acc;            // the band's hair: premultiplied RGB, alpha per cell
+    std::vector<float> zcell;          // per cell: nearest and farthest scene depth
+    std::vector<int> open;             // per block of columns: cells not yet opaque
     std::vector<float> zmax;           // per block of columns: the farthest scene depth
   };
 
  private:
   Mat4 m_view_proj = Mat4::Identity();
-  int m_fb_w = 0, m_fb_h = 0;
+  int m_fb_w = 0, m_fb_h = 0, m_k = 1;  // framebuffer and supersampling
+  int m_cw = 0, m_ch = 0;               // cells
   const HairSegments* m_hair = nullptr;
   std::vector<Point> m_pts;              // per point
   std::vector<uint32_t> m_seg_base;      // per strand: its first segment

@@ -648,7 +648,8 @@ class GlRenderer final : public Renderer {
     if (!m_splat->empty() && settings.hair_view_pass == "gpu")
       m_splat->view_pass(scene, view, view_proj, m_empty_vao);
     // Daldegan 1993 §4 step (5): the CPU-pass hair blended into the rendered scene.
-    const bool frame_on_cpu = cpu_hair && blend_cpu_hair(scene, view_proj, shadow_light, cpu_frame);
+    const bool frame_on_cpu =
+        cpu_hair && blend_cpu_hair(scene, view_proj, shadow_light, k, cpu_frame);
     if (!m_splat->empty() && settings.hair_view_pass != "gpu") {
       if (cpu_frame) {
         if (!frame_on_cpu) read_frame(*cpu_frame);
@@ -696,7 +697,7 @@ class GlRenderer final : public Renderer {
     m_arena->execute([&] { m_resolve.half_to_float(m_cpu_half.data(), nf, frame.data()); });
   }
 
-  // ---- Daldegan 1993 §4 CPU hair pass -----------------------------------------------------------
+  // ---- Daldegan 1993 §4 CPU hair pass ---------------------------------------------------------
 
   static bool is_cpu_hair(const StrandItem& item) {
     return item.material.shading == StrandShading::Daldegan1993 || item.hair_shadow;
@@ -824,7 +825,7 @@ class GlRenderer final : public Renderer {
   /// into the colour buffer of m_fbo, tested against its depth. With `cpu_frame` the whole
   /// frame is read into it and the hair drawn there (returns true: the caller resolves it);
   /// otherwise only the hair's rectangle is read back and uploaded again (returns false).
-  bool blend_cpu_hair(const RenderScene& scene, const Mat4& view_proj, int shadow_light,
+  bool blend_cpu_hair(const RenderScene& scene, const Mat4& view_proj, int shadow_light, int k,
                       std::vector<float>* cpu_frame) {
     const Context& ctx = *m_hair_ctx;
     std::vector<HairLight> lights;
@@ -857,12 +858,13 @@ class GlRenderer final : public Renderer {
       shade_hair_vertices(ctx, m_hair, h.strand_begin, h.strand_end, m_hair_base, sh, lights,
                           scene.camera.eye, m_hair_color);
     }
-    m_hair_blender.prepare(ctx, view_proj, m_hair, m_fb_w, m_fb_h);
+    m_hair_blender.prepare(ctx, view_proj, m_hair, m_fb_w, m_fb_h, k);
     const std::array<int, 4> box = m_hair_blender.bounds();
     glBindFramebuffer(GL_FRAMEBUFFER, m_fbo);
     if (cpu_frame) read_frame(*cpu_frame);
     if (box[0] >= box[2]) return cpu_frame != nullptr;  // no hair on screen
     HairFrame tg;
+    tg.samples = k;
     tg.fb_width = m_fb_w;
     tg.fb_height = m_fb_h;
     tg.x0 = box[0];

@@ -27,7 +27,7 @@ class HairRuntime {
     std::shared_ptr<const geom::StrandSet> styled;  // groom->strands
     std::vector<hair::HairMaterial> materials;      // of a HairStyler groom (else empty)
     // Roots riding a skin rig's deforming surface (the hair's mesh has a skin[] rig): the roots
-    // bound to the rig's refined rest mesh, and those bound points at rest (scene coordinates).
+    // bound to the rig's refined rest mesh, and the groom's roots at rest (scene coordinates).
     std::optional<std::size_t> skin_rig;
     hair::Groom skin_binding;
     std::vector<Vec3> skin_rest_roots;

@@ -107,9 +107,8 @@ HeadDistance head_distance(const Context& ctx, const geom::TriMesh& world) {
 
 FrameMetrics measure(const Context& ctx, const geom::StrandSet& s, const RestData& rest,
                      const HeadDistance& head, const std::optional<Affine3>& motion,
-                     const std::vector<Vec3>& rest_roots, const Vec3& gravity) {
+                     const std::vector<Vec3>& root_targets, const Vec3& gravity) {
   const Affine3 to_rest = motion ? motion->inverse() : Affine3::Identity();
-  const Affine3 to_world = motion ? *motion : Affine3::Identity();
   return deterministic_reduce(
       ctx, s.num_strands(), 64, FrameMetrics{},
       [&](std::size_t s0, std::size_t s1) {
@@ -134,9 +133,8 @@ FrameMetrics measure(const Context& ctx, const geom::StrandSet& s, const RestDat
               m.penetration = std::max(m.penetration, -d);
             }
           }
-          if (!rest_roots.empty())
-            m.drift =
-                std::max(m.drift, (s.points[b].cast<double>() - to_world * rest_roots[k]).norm());
+          if (!root_targets.empty())
+            m.drift = std::max(m.drift, (s.points[b].cast<double>() - root_targets[k]).norm());
         }
         return m;
       },
@@ -257,7 +255,6 @@ HarnessReport run_harness(const Scene& scene, const std::filesystem::path& base_
   }
 
   std::optional<HeadDistance> head;
-  std::vector<Vec3> rest_roots;
   for (const auto& name : models) {
     HarnessModelResult r;
     r.model = name;
@@ -272,7 +269,6 @@ HarnessReport run_harness(const Scene& scene, const std::filesystem::path& base_
       geom::TriMesh world = *session.mesh(mi);
       world.transform(base.assets.meshes[mi].transform.matrix());
       head = head_distance(ctx, world);
-      if (groom->bound()) rest_roots = hair::bound_root_positions(*groom, world);
       rep.groom_strands = groom->num_strands();
       rep.groom_points = groom->strands.num_points();
     }
@@ -293,7 +289,9 @@ HarnessReport run_harness(const Scene& scene, const std::filesystem::path& base_
     };
     const auto record = [&](int f, const geom::StrandSet& s) {
       const FrameMetrics m =
-          measure(ctx, s, rest, *head, session.head_motion_transform(f), rest_roots, anim.gravity);
+          measure(ctx, s, rest, *head, session.head_motion_transform(f),
+                  groom->bound() ? session.hair_root_targets(0, f) : std::vector<Vec3>{},
+                  anim.gravity);
       r.time_s.push_back(session.frame_time(f));
       r.stretch_percent.push_back(m.stretch);
       r.penetration_mm.push_back(m.penetration * 1e3);
@@ -353,7 +351,7 @@ HarnessReport run_harness(const Scene& scene, const std::filesystem::path& base_
     r.ms_per_simulated_second =
         r.error.empty() ? wall * 1e3 / (double(last - first) / anim.fps) : kNaN;
     if (!r.error.empty()) {
-      ctx.log().warn("harness: model {} stopped: {}", name, r.error);
+      ctx.log().info("harness: model {} stopped: {}", name, r.error);
       if (progress) progress->tick(std::size_t(last - first + 1) - ticks);
     }
     // Backward difference at the last frame measured.
@@ -540,8 +538,12 @@ image::ImageRGB8 harness_sheet(const HarnessReport& rep) {
         "simulated s   {} points",
         r.model, fixed(r.max_stretch_percent, 4), fixed(r.max_penetration_mm, 2),
         fixed(r.root_drift_mm, 4), fixed(r.ms_per_simulated_second, 0), r.points);
-    if (!r.error.empty()) l += "   STOPPED: " + r.error.substr(0, 120);
     lines.push_back(std::move(l));
+    if (!r.error.empty()) {  // on its own line, shortened to the width of the numbers
+      std::string e = fmt::format("stopped after {} frames: {}", r.frames, r.error);
+      if (e.size() > 110) e = e.substr(0, 107) + "...";
+      lines.push_back("  " + e);
+    }
   }
   int text_w = image::text_size(title, scale).width;
   for (const auto& l : lines) text_w = std::max(text_w, image::text_size(l, scale).width);
@@ -561,9 +563,13 @@ image::ImageRGB8 harness_sheet(const HarnessReport& rep) {
     image::blit(sheet, p, gap, y);
     y += p.height() + gap;
   }
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    image::fill_rect(sheet, gap, y + 4 * scale, 10 * scale, 2 * scale, image::palette_color(i));
-    image::draw_text(sheet, gap + 14 * scale, y, lines[i], ink, scale);
+  std::size_t model = 0;
+  for (const auto& l : lines) {
+    const bool detail = l.rfind("  ", 0) == 0;
+    if (!detail)
+      image::fill_rect(sheet, gap, y + 4 * scale, 10 * scale, 2 * scale,
+                       image::palette_color(model++));
+    image::draw_text(sheet, gap + 14 * scale, y, l, detail ? image::Rgb8{180, 30, 30} : ink, scale);
     y += line + 4;
   }
   return sheet;

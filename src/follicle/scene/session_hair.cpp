@@ -198,7 +198,12 @@ void Session::build_hair_group(std::size_t gi) {
     g.skin_binding = hair::Groom{};
     g.skin_binding.strands = groom->strands;
     hair::bind_roots(*m_ctx, geom::MeshQuery(refined), g.skin_binding);
-    g.skin_rest_roots = hair::bound_root_positions(g.skin_binding, refined);
+    // The strands are moved so their roots land on the bound points of the (deformed) refined
+    // surface: the offset from the groom's roots (a fraction of a mm where refinement moved the
+    // surface) is taken up at rest too.
+    g.skin_rest_roots.resize(groom->num_strands());
+    for (std::size_t k = 0; k < groom->num_strands(); ++k)
+      g.skin_rest_roots[k] = groom->strands.points[groom->strands.strand_begin(k)].cast<double>();
     g.skin_binding.strands = geom::StrandSet{};  // only the bindings are needed
     g.skin_binding.strands.offsets.assign(groom->num_strands() + 1, 0);
   }

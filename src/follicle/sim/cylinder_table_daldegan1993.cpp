@@ -34,8 +34,9 @@ CylinderAxis checked_axis(const CylinderAxis& in) {
   a.reference -= a.reference.dot(a.up) * a.up;
   const double nr = a.reference.norm();
   if (!(nr > 1e-9 * std::max(1.0, in.reference.norm())))
-    fail("cylinder table: reference direction is parallel to up; expected a direction across the "
-         "axis");
+    fail(
+        "cylinder table: reference direction is parallel to up; expected a direction across the "
+        "axis");
   a.reference /= nr;
   if (!(a.y1 > a.y0))
     fail("cylinder table: height range [{}, {}] is empty; expected y0 < y1", a.y0, a.y1);
@@ -232,6 +233,10 @@ bool CylinderTable::evaluate_near(float x, float z, float r2, float fj, int j, f
   return e.inside;
 }
 
+// Built for plain x86-64 and for AVX2 (the same results; picked at load time by the CPU).
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void CylinderTable::mark_candidates(const float* __restrict px, const float* __restrict py,
                                     const float* __restrict pz, std::size_t n, float extra,
                                     int* __restrict flag) const {
@@ -360,7 +365,8 @@ std::vector<CylinderPartParams> auto_cylinder_parts(const geom::TriMesh& mesh, c
   }
   std::vector<double> w(B, -1.0);
   for (int b = 0; b < B; ++b)
-    if (hi[std::size_t(b)] >= lo[std::size_t(b)]) w[std::size_t(b)] = hi[std::size_t(b)] - lo[std::size_t(b)];
+    if (hi[std::size_t(b)] >= lo[std::size_t(b)])
+      w[std::size_t(b)] = hi[std::size_t(b)] - lo[std::size_t(b)];
   for (int b = 1; b < B; ++b)
     if (w[std::size_t(b)] < 0) w[std::size_t(b)] = w[std::size_t(b - 1)];
   for (int b = B - 2; b >= 0; --b)
@@ -466,9 +472,9 @@ CylinderBody build_cylinder_body(const Context& ctx, const geom::TriMesh& mesh, 
     axis.reference = fr.front;
     axis.y0 = y0;
     axis.y1 = y1;
-    body.add_part(parts[k].name, CylinderTable::build(ctx, mesh, query, axis,
-                                                      params.azimuth_samples,
-                                                      params.height_samples, params.margin));
+    body.add_part(parts[k].name,
+                  CylinderTable::build(ctx, mesh, query, axis, params.azimuth_samples,
+                                       params.height_samples, params.margin));
   }
   return body;
 }

@@ -53,7 +53,7 @@ struct CylinderQuery {
   int part = -1;           // index of the part in a CylinderBody (0 for a single table)
   double r_p = 0, azimuth = 0, height = 0;  // P in cylindrical coordinates ([m], [rad], [m])
   double r_q = 0;                           // interpolated table radius [m] (without margin)
-  double distance = 0;       // (P - Q)·N [m]: the signed "PT" of (5), negative inside
+  double distance = 0;          // (P - Q)·N [m]: the signed "PT" of (5), negative inside
   Vec3 surface = Vec3::Zero();  // Q: radius r_q + margin on P's ray
   Vec3 closest = Vec3::Zero();  // T: P projected onto the tangent plane at Q
   Vec3 normal = Vec3::Zero();   // N: interpolated unit outward normal
@@ -61,7 +61,7 @@ struct CylinderQuery {
 
 /// Result of the single-precision contact query used by the solvers' inner loops.
 struct CylinderContactF {
-  float distance = 0;           // (P - Q)·N, Q at radius r_q + margin
+  float distance = 0;            // (P - Q)·N, Q at radius r_q + margin
   float nx = 0, ny = 0, nz = 0;  // N
   float depth_radial = 0;        // r_q + margin - r_p (> 0 inside)
 };
@@ -179,7 +179,8 @@ struct CylinderBodyParams {
     v("height_samples", height_samples, {"height samples n per part", "", 2, 4096});
     v("margin", margin, {"radial clearance added to every part", "m", 0.0, 0.1});
     v("parts", parts, {"height bands (empty: automatic head/neck/trunk split)"});
-    v("overlap", overlap, {"overlap of the automatic bands, fraction of the extent", "", 0.0, 0.25});
+    v("overlap", overlap,
+      {"overlap of the automatic bands, fraction of the extent", "", 0.0, 0.25});
   }
   void validate() const;
 };
@@ -206,7 +207,8 @@ class CylinderBody {
                        float extra, int* flag) const {
     for (const CylinderTable& t : m_parts) t.mark_candidates(px, py, pz, n, extra, flag);
   }
-  /// contact() of the deepest part (smallest distance); -1 when none.
+  /// contact() of the deepest part (inside the grown surface first, then the smallest
+  /// distance); -1 when none.
   inline int contact(float px, float py, float pz, float extra, CylinderContactF& c) const;
 
  private:
@@ -239,18 +241,18 @@ inline float fast_atan2(float y, float x) {
   const float mx = ax > ay ? ax : ay, mn = ax > ay ? ay : ax;
   const float a = mx > 0.0f ? mn / mx : 0.0f;
   const float s = a * a;
-  float r = ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s -
-             0.33262347f) *
-                s * a +
-            0.99997726f * a;
+  float r =
+      ((((-0.0117212f * s + 0.05265332f) * s - 0.11643287f) * s + 0.19354346f) * s - 0.33262347f) *
+          s * a +
+      0.99997726f * a;
   if (ay > ax) r = 1.57079637f - r;
   if (x < 0.0f) r = 3.14159274f - r;
   return y < 0.0f ? -r : r;
 }
 }  // namespace detail
 
-inline bool CylinderTable::locate(float px, float py, float pz, float extra, bool reject,
-                                  float& x, float& z, float& r2, float& fj, int& j) const {
+inline bool CylinderTable::locate(float px, float py, float pz, float extra, bool reject, float& x,
+                                  float& z, float& r2, float& fj, int& j) const {
   if (m_n < 2) return false;
   const float dx = px - m_o[0], dy = py - m_o[1], dz = pz - m_o[2];
   const float y = dx * m_u[0] + dy * m_u[1] + dz * m_u[2];
@@ -268,8 +270,8 @@ inline bool CylinderTable::locate(float px, float py, float pz, float extra, boo
     const int q = z >= 0.0f ? (x >= 0.0f ? 0 : 1) : (x < 0.0f ? 2 : 3);
     const float u = (q & 1) ? az : ax, v = (q & 1) ? ax : az;  // v / u = tan(angle in quadrant)
     const int sub = int(v > 0.41421356f * u) + int(v > u) + int(v > 2.41421356f * u);
-    const float reach = m_sector_max[std::size_t(j) * kSectors + std::size_t(4 * q + sub)] +
-                        m_marginf + extra;
+    const float reach =
+        m_sector_max[std::size_t(j) * kSectors + std::size_t(4 * q + sub)] + m_marginf + extra;
     if (r2 >= reach * reach) return false;
   }
   return true;
@@ -296,13 +298,17 @@ inline bool CylinderTable::contact(float px, float py, float pz, float extra,
 
 inline int CylinderBody::contact(float px, float py, float pz, float extra,
                                  CylinderContactF& c) const {
+  // Parts where P is inside the (grown) surface itself come first, then the smallest distance.
   int best = -1;
   CylinderContactF t;
-  for (std::size_t k = 0; k < m_parts.size(); ++k)
-    if (m_parts[k].contact(px, py, pz, extra, t) && (best < 0 || t.distance < c.distance)) {
+  for (std::size_t k = 0; k < m_parts.size(); ++k) {
+    if (!m_parts[k].contact(px, py, pz, extra, t)) continue;
+    const bool in = t.depth_radial > 0.0f, best_in = best >= 0 && c.depth_radial > 0.0f;
+    if (best < 0 || (in && !best_in) || (in == best_in && t.distance < c.distance)) {
       c = t;
       best = int(k);
     }
+  }
   return best;
 }
 

@@ -1,8 +1,6 @@
 // The wisp model (Daldegan et al. 1993 §3.3): binding to the nearest guide root, followers that
 // reproduce the rest hair, follow translations and rigid head motion, guides and followers of
 // different point counts (arc-length fractions), the paper's jittered copies, bad inputs.
-#include "follicle/hair/wisp_daldegan1993.hpp"
-
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -14,6 +12,7 @@
 #include "follicle/core/context.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/rng.hpp"
+#include "follicle/hair/wisp_daldegan1993.hpp"
 
 using namespace follicle;
 using namespace follicle::hair;
@@ -30,8 +29,8 @@ std::vector<Vec3f> curly(const Vec3& root, int n, double L, double seed) {
   std::vector<Vec3f> pts;
   for (int i = 0; i < n; ++i) {
     const double u = double(i) / (n - 1);
-    pts.push_back((root + L * Vec3(0.3 * std::sin(7 * u + seed), -u, 0.2 * std::cos(5 * u + seed) -
-                                                                         0.2 * std::cos(seed)))
+    pts.push_back((root + L * Vec3(0.3 * std::sin(7 * u + seed), -u,
+                                   0.2 * std::cos(5 * u + seed) - 0.2 * std::cos(seed)))
                       .cast<float>());
   }
   return pts;
@@ -105,7 +104,8 @@ TEST(Wisps, StillGuidesReproduceTheRestHairExactly) {
   apply_wisps(b, h.guides, h.guides, Quat::Identity(), out);
   ASSERT_EQ(out.offsets, h.full.offsets);
   ASSERT_EQ(out.points.size(), h.full.points.size());
-  EXPECT_EQ(std::memcmp(out.points.data(), h.full.points.data(), out.points.size() * sizeof(Vec3f)), 0);
+  EXPECT_EQ(std::memcmp(out.points.data(), h.full.points.data(), out.points.size() * sizeof(Vec3f)),
+            0);
   // Same through the HeadMotion overload and the parallel one.
   geom::StrandSet out2, out3;
   apply_wisps(b, h.guides, h.guides, HeadMotion{}, out2);
@@ -144,8 +144,8 @@ TEST(Wisps, FollowersFollowTranslationAndRigidHeadMotion) {
 TEST(Wisps, DifferentPointCountsUseArcLengthFractions) {
   // Guide: straight along +x, 5 points over 1 m; now bent into an L (up to x = 0.5, then +y).
   geom::StrandSet guide, guide_now, full;
-  guide.add_strand({Vec3f(0, 0, 0), Vec3f(0.25f, 0, 0), Vec3f(0.5f, 0, 0), Vec3f(0.75f, 0, 0),
-                    Vec3f(1, 0, 0)});
+  guide.add_strand(
+      {Vec3f(0, 0, 0), Vec3f(0.25f, 0, 0), Vec3f(0.5f, 0, 0), Vec3f(0.75f, 0, 0), Vec3f(1, 0, 0)});
   guide_now.add_strand({Vec3f(0, 0, 0), Vec3f(0.25f, 0, 0), Vec3f(0.5f, 0, 0),
                         Vec3f(0.5f, 0.25f, 0), Vec3f(0.5f, 0.5f, 0)});
   // Follower: 11 points, half the length, 0.1 to the side, unevenly spaced.
@@ -182,7 +182,8 @@ TEST(Wisps, DifferentPointCountsUseArcLengthFractions) {
   dot_guide.add_strand({Vec3f(1, 2, 3)});
   dot_full.add_strand({Vec3f(1, 2, 4)});
   const WispBinding bd = bind_wisps(dot_guide, dot_full, WispParams{});
-  apply_wisps(bd, dot_guide, moved(dot_guide, Mat3::Identity(), Vec3(1, 0, 0)), Quat::Identity(), out);
+  apply_wisps(bd, dot_guide, moved(dot_guide, Mat3::Identity(), Vec3(1, 0, 0)), Quat::Identity(),
+              out);
   EXPECT_LT((out.points[0] - Vec3f(2, 2, 4)).norm(), 1e-6);
 }
 

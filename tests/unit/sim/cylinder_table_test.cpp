@@ -1,8 +1,6 @@
 // Cylindrical radius tables (Daldegan et al. 1993 §3.2, Fig. 3): tables of analytic shapes,
 // inside/outside, the nearest-point approximation, azimuth wrap-around, gaps, any orientation,
 // the automatic head/neck/trunk split and bad parameters.
-#include "follicle/sim/cylinder_table_daldegan1993.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +8,7 @@
 #include "follicle/core/context.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/rng.hpp"
+#include "follicle/sim/cylinder_table_daldegan1993.hpp"
 
 using namespace follicle;
 using follicle::sim::CylinderAxis;
@@ -53,8 +52,8 @@ geom::TriMesh tube(const Vec3& c, double ax, double az, double ya, double yb, in
   for (int j = 0; j <= nh; ++j)
     for (int i = 0; i < nu; ++i) {
       const double ph = 2 * kPi * i / nu;
-      m.positions.push_back(
-          c + Vec3(ax * std::cos(ph), ya + (yb - ya) * j / nh, az * std::sin(ph)));
+      m.positions.push_back(c +
+                            Vec3(ax * std::cos(ph), ya + (yb - ya) * j / nh, az * std::sin(ph)));
     }
   auto id = [&](int i, int j) { return j * nu + (i % nu); };
   for (int j = 0; j < nh; ++j)
@@ -93,8 +92,7 @@ TEST(CylinderTable, SphereRadiiAndNormals) {
   const Vec3 c(0.01, 1.6, -0.02);
   const double R = 0.1;
   const geom::TriMesh m = sphere(c, R);
-  const CylinderTable t =
-      CylinderTable::build(ctx, m, y_axis(c, -0.095, 0.095), 64, 33);
+  const CylinderTable t = CylinderTable::build(ctx, m, y_axis(c, -0.095, 0.095), 64, 33);
   // Tessellation error of a 96 × 48 sphere: R (1 - cos(π/48)) ≈ 2e-4 R; more near the poles.
   for (int j = 0; j < t.height_samples(); ++j) {
     const double y = t.sample_height(j);
@@ -164,8 +162,8 @@ TEST(CylinderTable, CylinderRadiusMarginAndHeightRange) {
   const Vec3 o(0.3, 0.2, 0.2);
   const Vec3 dir = Vec3(1, 0, 1).normalized();
   EXPECT_TRUE(t.inside(o + 0.040 * dir));
-  EXPECT_TRUE(t.inside(o + 0.052 * dir));   // within the 4 mm margin
-  EXPECT_FALSE(t.inside(o + 0.0545 * dir));  // beyond it
+  EXPECT_TRUE(t.inside(o + 0.052 * dir));          // within the 4 mm margin
+  EXPECT_FALSE(t.inside(o + 0.0545 * dir));        // beyond it
   EXPECT_TRUE(t.inside(o + 0.0545 * dir, 0.001));  // widened by `extra`
   const sim::CylinderQuery q = t.query(o + 0.045 * dir);
   EXPECT_NEAR(q.distance, -0.009, 2e-4);  // (P - Q)·N, Q at R + margin
@@ -195,7 +193,8 @@ TEST(CylinderTable, RotatedMeshGivesTheSameTable) {
   for (int j = 0; j < 12; ++j)
     for (int i = 0; i < 40; ++i) {
       EXPECT_NEAR(t0.radius(i, j), t1.radius(i, j), 1e-6);
-      EXPECT_GT((Rm * t0.normal(i, j)).dot(t1.normal(i, j)), std::cos(6.0 * kPi / 180.0));  // edge hits may pick either face
+      EXPECT_GT((Rm * t0.normal(i, j)).dot(t1.normal(i, j)),
+                std::cos(6.0 * kPi / 180.0));  // edge hits may pick either face
     }
   // Analytic radius of the ellipse at the sample azimuths (polygon error ~ 3e-4 of the axis).
   for (int i = 0; i < 40; ++i) {
@@ -221,7 +220,9 @@ TEST(CylinderTable, AzimuthWrapAroundIsContinuous) {
   const int M = t.azimuth_samples();
   // The table's azimuth runs from `reference` towards up × reference.
   const Vec3 ra = t.axis().reference, rb = t.axis().up.cross(ra);
-  auto at = [&](double th, double y) { return 1e-3 * (std::cos(th) * ra + std::sin(th) * rb) + y * Vec3::UnitY(); };
+  auto at = [&](double th, double y) {
+    return 1e-3 * (std::cos(th) * ra + std::sin(th) * rb) + y * Vec3::UnitY();
+  };
   EXPECT_GT(std::abs(t.radius(M - 1, 2) - t.radius(0, 2)), 1e-3);  // a real jump to bridge
   double prev = -1;
   for (int k = -200; k <= 200; ++k) {
@@ -356,7 +357,7 @@ TEST(CylinderBody, AutomaticHeadNeckTrunkSplit) {
   EXPECT_EQ(part_of(Vec3(0.0, 0.45, 0.05)), "head");
   EXPECT_EQ(part_of(Vec3(0.15, 0.1, 0.0)), "trunk");
   EXPECT_EQ(part_of(Vec3(0.0, 0.45, 0.11)), "none");
-  EXPECT_EQ(part_of(Vec3(0.1, 0.32, 0.0)), "none");  // beside the neck, above the shoulders
+  EXPECT_EQ(part_of(Vec3(0.1, 0.32, 0.0)), "none");   // beside the neck, above the shoulders
   EXPECT_NE(part_of(Vec3(0.0, 0.31, 0.03)), "none");  // in the neck
   EXPECT_TRUE(body.inside(Vec3(0.19, 0.2, 0.0)));
   EXPECT_FALSE(body.inside(Vec3(0.21, 0.2, 0.0)));
