@@ -31,3 +31,16 @@ echo "demo: wrote out/hand.mp4"
 "$FOLLICLE" animate data/scenes/lcp_wind.json -o out/lcp-wind-frames --mp4 out/lcp-wind.mp4
 cp out/lcp-wind-frames/frame_0024.png out/lcp-wind.png
 echo "demo: wrote out/lcp-wind.png and out/lcp-wind.mp4"
+# Daldegan 1993 (HairStyler, hinge dynamics, cylinder collision, shadow-buffer rendering): beard,
+# moustache and eyebrows on the wrinkled face, long hair, fur, and the wind clip.
+for s in daldegan_beard daldegan_long daldegan_fur; do
+  "$FOLLICLE" render "data/scenes/$s.json" -o "out/${s//_/-}.png"
+  echo "demo: wrote out/${s//_/-}.png"
+done
+"$FOLLICLE" animate data/scenes/daldegan_wind.json -o out/daldegan-wind-frames \
+  --mp4 out/daldegan-wind.mp4 --cache out/daldegan-wind-cache
+echo "demo: wrote out/daldegan-wind.mp4"
+# Hair on a face changing expression: the roots ride the deforming, wrinkling skin.
+"$FOLLICLE" animate data/scenes/hair_expression.json -o out/hair-expression-frames \
+  --mp4 out/hair-expression.mp4
+echo "demo: wrote out/hair-expression.mp4"

@@ -17,6 +17,7 @@ void add_splat_workloads(std::vector<Workload>& out);
 void add_lcp_workloads(std::vector<Workload>& out);
 void add_hair_render_workloads(std::vector<Workload>& out);
 void add_face_render_workloads(std::vector<Workload>& out);
+void add_daldegan_workloads(std::vector<Workload>& out);
 
 std::vector<Workload> all_workloads() {
   std::vector<Workload> out;
@@ -29,6 +30,7 @@ std::vector<Workload> all_workloads() {
   add_lcp_workloads(out);
   add_hair_render_workloads(out);
   add_face_render_workloads(out);
+  add_daldegan_workloads(out);
   return out;
 }
 

@@ -103,9 +103,9 @@ void HairStylerSpec::read_json_custom(const Json& j, const std::string& path,
   read_json(overrides, path, probe, src);
   if (preset.empty()) {
     try {
-      probe.validate();
-    } catch (const Error& e) {
-      json_fail(src, path, e.what());
+      probe.validate(path);
+    } catch (const Error& e) {  // the message names the path inside the styler
+      throw Error(src.file, e.what());
     }
   }
 }
@@ -124,9 +124,9 @@ hair::HairStylerParams HairStylerSpec::resolve(const geom::TriMesh& mesh, const 
   if (!preset.empty()) p = hair::styler_preset(preset, mesh, up, front);
   read_json(overrides, path, p, src);
   try {
-    p.validate();
-  } catch (const Error& e) {
-    json_fail(src, path, e.what());
+    p.validate(path);
+  } catch (const Error& e) {  // the message names the path inside the styler
+    throw Error(src.file, e.what());
   }
   return p;
 }

@@ -288,10 +288,9 @@ HarnessReport run_harness(const Scene& scene, const std::filesystem::path& base_
       }
     };
     const auto record = [&](int f, const geom::StrandSet& s) {
-      const FrameMetrics m =
-          measure(ctx, s, rest, *head, session.head_motion_transform(f),
-                  groom->bound() ? session.hair_root_targets(0, f) : std::vector<Vec3>{},
-                  anim.gravity);
+      const FrameMetrics m = measure(
+          ctx, s, rest, *head, session.head_motion_transform(f),
+          groom->bound() ? session.hair_root_targets(0, f) : std::vector<Vec3>{}, anim.gravity);
       r.time_s.push_back(session.frame_time(f));
       r.stretch_percent.push_back(m.stretch);
       r.penetration_mm.push_back(m.penetration * 1e3);

@@ -188,6 +188,8 @@ void Session::build_hair_group(std::size_t gi) {
       hair::bind_roots(*m_ctx, query, *groom);
     }
   } catch (const Error& e) {
+    // Errors that already name the scene file and their JSON path (styler) pass unchanged.
+    if (std::string_view(e.what()).starts_with(m_source + ": hair[")) throw;
     fail("{}: {}", w, e.what());
   }
   // A mesh with a skin rig deforms: the roots ride its refined surface (ride_skin).

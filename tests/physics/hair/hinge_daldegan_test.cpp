@@ -240,6 +240,27 @@ TEST(HingePhysics, StaticSagBalancesSpringAndGravity) {
     }
 }
 
+// The springs pull to the nearest turn of the styled angle: an angle wound up by whole turns
+// (as φ can near a pole of its frame) stays put instead of unwinding turn by turn.
+TEST(HingePhysics, WoundUpAnglesDoNotUnwind) {
+  Context ctx(1, 1);
+  HingeParams p = bare_params();
+  p.k_theta = p.k_phi = 2e-9;
+  geom::StrandSet rest;
+  add_straight(rest, Vec3::Zero(), Vec3(1, 0, 0), 1, 0.01);
+  const HingeSolver solver(p, rest, nullptr);
+  HingeState st = solver.initial_state(), ref = st;
+  st.phi[0] += 6 * kPi + 0.01;
+  ref.phi[0] += 0.01;
+  EXPECT_NEAR(solver.potential_energy(st, no_gravity()), 0.5 * p.k_phi * 0.01 * 0.01, 1e-18);
+  for (int n = 0; n < 100; ++n) {
+    ASSERT_TRUE(solver.step(ctx, no_gravity(), st).ok);
+    ASSERT_TRUE(solver.step(ctx, no_gravity(), ref).ok);
+  }
+  EXPECT_NEAR(st.phi[0] - 6 * kPi, ref.phi[0], 1e-9);
+  EXPECT_NEAR(st.dphi[0], ref.dphi[0], 1e-6 * std::abs(ref.dphi[0]) + 1e-9);
+}
+
 // Wind drag on a strand hanging straight down (the pole of the head frame): with polar_frame
 // "rest" it swings downwind to k ψ + m g l/2 sin ψ = (l/2) c_w l w cos ψ.
 TEST(HingePhysics, SideWindOnAHangingSegment) {

@@ -139,3 +139,30 @@ TEST(GroomScene, BadGroomsNameTheJsonPath) {
   EXPECT_THAT(e, HasSubstr("assets.grooms[0]"));
   EXPECT_THAT(e, HasSubstr("cut.hair"));
 }
+
+TEST(GroomScene, RootsRideAFaceChangingExpression) {
+  // hair_expression.json: neutral -> surprise -> angry; the roots stay on the deformed, refined
+  // skin (root drift < 0.1 mm, issue 20) while the forehead moves under them.
+  const Context ctx(2, 1);
+  Json j = scene_json("hair_expression");
+  j["hair"][0]["density_scale"] = 0.03;
+  j["animation"]["duration"] = 0.0;
+  j["animation"]["frames"] = 31;
+  Session s = Session::from_json(j, scenes_dir(), "hair_expression", ctx);
+  const auto groom = s.hair_groom(0);
+  double drift = 0, moved = 0;
+  for (int f : {0, 15, 30}) {
+    const auto strands = s.hair_strands(0, f);
+    const auto targets = s.hair_root_targets(0, f);
+    ASSERT_EQ(targets.size(), strands->num_strands());
+    for (std::size_t k = 0; k < targets.size(); ++k) {
+      const Vec3 root = strands->points[strands->strand_begin(k)].cast<double>();
+      drift = std::max(drift, (root - targets[k]).norm());
+      moved = std::max(
+          moved,
+          (root - groom->strands.points[groom->strands.strand_begin(k)].cast<double>()).norm());
+    }
+  }
+  EXPECT_LT(drift, 1e-4);
+  EXPECT_GT(moved, 1e-3);  // the surprised brow lifts the hairline by millimetres
+}
