@@ -22,10 +22,10 @@ namespace follicle::hair {
 
 /// What acts on the hair at time t, in world coordinates.
 struct HairEnvironment {
-  Vec3 gravity{0.0, -9.81, 0.0};  // [m/s²]
-  Vec3 wind = Vec3::Zero();       // [m/s²] uniform wind: force per unit mass of hair
+  Vec3 gravity{0.0, -9.81, 0.0};     // [m/s²]
+  Vec3 wind = Vec3::Zero();          // [m/s²] uniform wind: force per unit mass of hair
   Vec3 air_velocity = Vec3::Zero();  // [m/s] uniform air velocity (models with drag)
-  HeadMotion head;                // the head frame (origin, orientation) and its derivatives
+  HeadMotion head;                   // the head frame (origin, orientation) and its derivatives
 };
 using EnvironmentFn = std::function<HairEnvironment(double t)>;
 
