@@ -203,17 +203,10 @@ void apply_impl(const WispBinding& b, const geom::StrandSet& grest, const geom::
       const float u = b.u[fb + j];
       while (k + 2 < gn && b.guide_u[gb + k + 1] < u) ++k;
       Vec3 now, rest;
-      Mat3 Q = Mat3::Identity();  // turn of the guide's segment since rest ("offset" mode)
       if (gn == 1) {
         now = gnow.points[gb].cast<double>();
         rest = grest.points[gb].cast<double>();
       } else {
-        if (!b.paper) {
-          const Vec3 tr = R * (grest.points[gb + k + 1] - grest.points[gb + k]).cast<double>();
-          const Vec3 tn = (gnow.points[gb + k + 1] - gnow.points[gb + k]).cast<double>();
-          if (tr.squaredNorm() > 0 && tn.squaredNorm() > 0)
-            Q = Eigen::Quaterniond::FromTwoVectors(tr, tn).toRotationMatrix();
-        }
         const double u0 = b.guide_u[gb + k], u1 = b.guide_u[gb + k + 1];
         const double w = u1 > u0 ? std::clamp((double(u) - u0) / (u1 - u0), 0.0, 1.0) : 0.0;
         now = (1 - w) * gnow.points[gb + k].cast<double>() +
@@ -224,14 +217,10 @@ void apply_impl(const WispBinding& b, const geom::StrandSet& grest, const geom::
       if (b.paper) {
         out.points[fb + j] = (now + shift).cast<float>();
       } else {
-        // x = g_now + Q R (x_rest - g_rest): the follower's rest offset from the guide point at
-        // its arc-length fraction, turned by the head and by the turn Q of the guide's segment
-        // (minimal rotation from its rest to its current direction), so followers bend with
-        // their guide instead of stretching. Written as x_rest + (g_now - g_rest) +
-        // (QR - I)(x_rest - g_rest) so that still guides and R = I give x_rest bit for bit.
+        // x = x_rest + (g_now - g_rest) + (R - I)(x_rest - g_rest) = g_now + R (x_rest - g_rest),
+        // written so that still guides and R = I give x_rest bit for bit.
         const Vec3 xr = b.rest[fb + j].cast<double>();
-        const Mat3 QRmI = Q == Mat3::Identity() ? RmI : Mat3(Q * R - Mat3::Identity());
-        out.points[fb + j] = (xr + (now - rest) + QRmI * (xr - rest)).cast<float>();
+        out.points[fb + j] = (xr + (now - rest) + RmI * (xr - rest)).cast<float>();
       }
     }
   });

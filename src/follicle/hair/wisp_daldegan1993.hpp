@@ -8,10 +8,8 @@
 //     jitter (both turned with the head), sampled at the follower's arc-length fractions, so it
 //     takes the guide's length and shape.
 //   mode "offset" (ours, default): every follower point keeps its rest offset from the guide
-//     point at the same arc-length fraction, turned by the head rotation R and by the turn Q_k
-//     of the guide's segment k holding that fraction (the minimal rotation from its rest
-//     direction, turned by R, to its current one), so followers bend with their guide:
-//       x_j(t) = g(u_j, t) + Q_k R (x_j(rest) - g(u_j, rest)),
+//     point at the same arc-length fraction, turned by the head rotation:
+//       x_j(t) = g(u_j, t) + R (x_j(rest) - g(u_j, rest)),
 //     so followers keep their own styled lengths and shapes and reproduce the rest hair exactly
 //     when the guides are at rest.
 // Guide points are interpolated linearly in the guide's REST arc-length fraction (a material
