@@ -252,7 +252,10 @@ void CylinderTable::mark_candidates(const float* __restrict px, const float* __r
     const float dx = px[k] - o0, dy = py[k] - o1, dz = pz[k] - o2;
     const float y = dx * u0 + dy * u1 + dz * u2;
     const int in_range = int(y >= y0) & int(y <= y1);
-    const float fj = std::min(std::max((y - y0) * inv_dy, 0.0f), float(jmax));
+    // Clamped to [0, jmax]; a NaN (bad input, reported by the solver) maps to row 0, never to an
+    // out-of-range int conversion.
+    const float fr = (y - y0) * inv_dy;
+    const float fj = fr > 0.0f ? (fr < float(jmax) ? fr : float(jmax)) : 0.0f;
     const int j = int(fj);
     const float x = dx * a0 + dy * a1 + dz * a2;
     const float z = dx * b0 + dy * b1 + dz * b2;
