@@ -19,7 +19,6 @@
 #include "follicle/image/plot.hpp"
 #include "follicle/render/renderer.hpp"
 #include "follicle/scene/session.hpp"
-#include "follicle/sim/ellipsoid.hpp"
 
 namespace follicle::scene {
 
@@ -28,24 +27,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kFloatEps = std::numeric_limits<float>::epsilon();
 constexpr double kStretchUlps = 4.0;  // rounding allowance of a segment length, in float ulps
-
-// The default head-motion pivot of session_hair.cpp: the bottom of hair[0]'s hull (used when
-// the harness keeps another group only, so the motion stays the scene's).
-Vec3 default_pivot(const Scene& scene, const std::filesystem::path& base_dir,
-                   const std::string& source, const Context& ctx) {
-  const HairGroupSpec& h0 = scene.hair[0];
-  sim::Ellipsoid hull;
-  if (h0.hull) {
-    hull = h0.hull->ellipsoid();
-  } else {
-    Session s(scene, base_dir, source, ctx);
-    const std::size_t mi = s.mesh_index(h0.mesh);
-    geom::TriMesh world = *s.mesh(mi);
-    world.transform(scene.assets.meshes[mi].transform.matrix());
-    hull = sim::fit_head_ellipsoid(world.positions, h0.hull_fit);
-  }
-  return hull.centre - hull.rotation * Vec3(0.0, hull.radii.y(), 0.0);
-}
 
 HairModel model_from_name(const std::string& name) {
   for (const auto& [e, n] : follicle_enum_names(HairModel{}))
@@ -242,7 +223,7 @@ HarnessReport run_harness(const Scene& scene, const std::filesystem::path& base_
   Scene base = scene;
   if (options.group != 0 && anim.head_motion.kind != HeadMotionKind::None &&
       !anim.head_motion.pivot)
-    base.animation->head_motion.pivot = default_pivot(scene, base_dir, source, ctx);
+    base.animation->head_motion.pivot = Session(scene, base_dir, source, ctx).head_motion_pivot();
   base.hair = {scene.hair[options.group]};
   base.lcp.reset();
   base.hand.reset();

@@ -15,6 +15,7 @@
 #include "follicle/image/image.hpp"
 #include "follicle/render/render_scene.hpp"
 #include "follicle/scene/scene.hpp"
+#include "follicle/sim/ellipsoid.hpp"
 #include "follicle/skin/face_rig.hpp"
 #include "follicle/skin/hand_rig.hpp"
 
@@ -100,6 +101,11 @@ class Session {
   /// Every hair group at `frame`, concatenated (for export).
   geom::StrandSet all_hair(int frame);
   const HairStats& hair_stats() const;
+  /// The pivot of the rigid head motion: animation.head_motion.pivot, or the bottom of hair[0]'s
+  /// hull (roughly where the neck turns the head).
+  Vec3 head_motion_pivot();
+  /// The head hull of hair group `group` (its `hull`, or fitted to its mesh at rest).
+  sim::Ellipsoid hair_hull(std::size_t group);
   /// The rigid head-motion transform at `frame` (rest -> current), none for a still head.
   std::optional<Affine3> head_motion_transform(int frame);
 

@@ -148,7 +148,7 @@ void Session::build_hair_group(std::size_t gi) {
   world.transform(m_scene.assets.meshes[mi].transform.matrix());
   auto groom = std::make_shared<hair::Groom>();
   try {
-    g.hull = hs.hull ? hs.hull->ellipsoid() : sim::fit_head_ellipsoid(world.positions, hs.hull_fit);
+    g.hull = hair_hull(gi);
     const geom::MeshQuery query(world);
     if (!hs.groom.empty()) {  // an imported groom, placed like its asset says
       const std::size_t gai = groom_index(hs.groom);
@@ -257,6 +257,24 @@ void Session::ride_skin(std::size_t gi, int frame, geom::StrandSet& strands) {
   }
 }
 
+sim::Ellipsoid Session::hair_hull(std::size_t gi) {
+  const HairGroupSpec& hs = m_scene.hair.at(gi);
+  if (hs.hull) return hs.hull->ellipsoid();
+  const std::size_t mi = mesh_index(hs.mesh);
+  geom::TriMesh world = *mesh(mi);
+  world.transform(m_scene.assets.meshes[mi].transform.matrix());
+  return sim::fit_head_ellipsoid(world.positions, hs.hull_fit);
+}
+
+Vec3 Session::head_motion_pivot() {
+  if (m_scene.animation && m_scene.animation->head_motion.pivot)
+    return *m_scene.animation->head_motion.pivot;
+  if (m_scene.hair.empty()) return Vec3::Zero();
+  // The bottom of the first group's hull: roughly where the neck turns the head.
+  const sim::Ellipsoid h0 = hair_hull(0);
+  return h0.centre - h0.rotation * Vec3(0.0, h0.radii.y(), 0.0);
+}
+
 std::shared_ptr<const hair::Groom> Session::hair_groom(std::size_t gi) {
   if (gi >= m_scene.hair.size())
     fail("hair group {} out of range ({} groups)", gi, m_scene.hair.size());
@@ -290,15 +308,7 @@ std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int
   if (!m_scene.animation) frame = 0;
   if (!rt.track_built) {
     if (anim_spec.head_motion.kind != HeadMotionKind::None) {
-      Vec3 pivot;
-      if (anim_spec.head_motion.pivot) {
-        pivot = *anim_spec.head_motion.pivot;
-      } else {  // the bottom of the first group's hull: roughly where the neck turns the head
-        build_hair_group(0);
-        const auto& h0 = rt.groups[0].hull;
-        pivot = h0.centre - h0.rotation * Vec3(0.0, h0.radii.y(), 0.0);
-      }
-      rt.track = make_track(anim_spec.head_motion, pivot);
+      rt.track = make_track(anim_spec.head_motion, head_motion_pivot());
     }
     rt.track_built = true;
   }
