@@ -289,9 +289,11 @@ Chain cantilever_chain(const ScalpPoint& sp, const Vec3& tr, double L, double s,
   return {x, d};
 }
 
+}  // namespace
+
 // The order of the points along a Morton (Z-order) curve over their bounding box (21 bits per
 // axis; ties keep the input order).
-std::vector<uint32_t> zorder(const std::vector<Vec3>& x) {
+std::vector<uint32_t> lcp_zorder(const std::vector<Vec3>& x) {
   const std::size_t n = x.size();
   Vec3 lo = x[0], hi = x[0];
   for (const Vec3& xi : x) {
@@ -319,8 +321,6 @@ std::vector<uint32_t> zorder(const std::vector<Vec3>& x) {
                    [&](uint32_t a, uint32_t b) { return code[a] < code[b]; });
   return order;
 }
-
-}  // namespace
 
 std::vector<char> lcp_attached(const LcpModel& m) {
   const std::size_t n = m.size();
@@ -422,7 +422,7 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
   // (dart throwing alone numbers them in random order over the scalp, and every loop then reads
   // much of what the other core has just written).
   {
-    const std::vector<uint32_t> order = zorder(x);
+    const std::vector<uint32_t> order = lcp_zorder(x);
     auto permute = [&](std::vector<Vec3>& v) {
       std::vector<Vec3> o(n);
       for (std::size_t i = 0; i < n; ++i) o[i] = v[order[i]];

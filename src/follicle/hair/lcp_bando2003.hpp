@@ -238,6 +238,11 @@ struct LcpInit {
 LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitParams& p,
                        const sim::VoxelPlanes* body = nullptr);
 
+/// The order of the points along a Morton (Z-order) curve over their bounding box (21 bits per
+/// axis; ties keep the input order): numbering particles in this order puts neighbours near in
+/// memory. x must not be empty.
+std::vector<uint32_t> lcp_zorder(const std::vector<Vec3>& x);
+
 /// 1 for root particles and for every particle reachable from one through root-side -> tip-side
 /// connections (i.e. held by the head), 0 otherwise.
 std::vector<char> lcp_attached(const LcpModel& model);

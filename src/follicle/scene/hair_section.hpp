@@ -12,6 +12,7 @@
 #include "follicle/core/params.hpp"
 #include "follicle/core/types.hpp"
 #include "follicle/geom/trimesh.hpp"
+#include "follicle/hair/hair_model_bando2003.hpp"
 #include "follicle/hair/hair_model_daldegan1993.hpp"
 #include "follicle/hair/hairdressing_anjyo1992.hpp"
 #include "follicle/hair/hairstyler_daldegan1993.hpp"
@@ -24,9 +25,11 @@ namespace follicle::scene {
 
 // The hair models every hair[] entry can run on its groom (ADR 0010); the model table is
 // make_simulation in session_hair.cpp.
-enum class HairModel { Anjyo1992, Daldegan1993 };
-constexpr std::array<std::pair<HairModel, const char*>, 2> follicle_enum_names(HairModel) {
-  return {{{HairModel::Anjyo1992, "anjyo1992"}, {HairModel::Daldegan1993, "daldegan1993"}}};
+enum class HairModel { Anjyo1992, Daldegan1993, Bando2003 };
+constexpr std::array<std::pair<HairModel, const char*>, 3> follicle_enum_names(HairModel) {
+  return {{{HairModel::Anjyo1992, "anjyo1992"},
+           {HairModel::Daldegan1993, "daldegan1993"},
+           {HairModel::Bando2003, "bando2003"}}};
 }
 
 /// An explicit ellipsoid hull (Anjyo 1992 §2 step [α]) replacing the automatic fit. Scene
@@ -118,6 +121,7 @@ struct HairGroupSpec {
   double density_scale = 1.0;
   hair::ProjectiveParams dynamics;
   hair::DaldeganParams daldegan;
+  hair::BandoParams bando;
   hair::AnjyoShadingParams shading;
   HairRenderParams render;
   uint64_t seed = 1;
@@ -150,8 +154,12 @@ struct HairGroupSpec {
     v("daldegan", daldegan,
       ParamInfo{"hinge dynamics, body collision and wisps of model daldegan1993 (Daldegan 1993 "
                 "§3)"});
+    v("bando", bando,
+      ParamInfo{"loosely connected particles of model bando2003 on the groom (Bando 2003; thesis "
+                "ch. 3): particle sampling, dynamics, body collision, wisps"});
     v("shading", shading,
-      ParamInfo{"anisotropic shading of anjyo1992 hair (Anjyo 1992 §4, eqs. 8-9); daldegan1993 "
+      ParamInfo{"anisotropic shading of anjyo1992 and bando2003 hair (Anjyo 1992 §4, eqs. 8-9); "
+                "daldegan1993 "
                 "hair uses its styler materials and eq. (7)"});
     v("render", render, ParamInfo{"how the strands are drawn"});
     v("seed", seed, ParamInfo{"random seed of pores, lengths, k_a and fluctuation"});

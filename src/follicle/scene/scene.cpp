@@ -89,6 +89,11 @@ void Scene::validate(const JsonSource& src) const {
       json_fail(src, p + ".daldegan", e.what());
     }
     try {
+      h.bando.validate();
+    } catch (const Error& e) {
+      json_fail(src, p + ".bando", e.what());
+    }
+    try {
       h.shading.validate();
     } catch (const Error& e) {
       json_fail(src, p + ".shading", e.what());

@@ -105,8 +105,20 @@ std::unique_ptr<hair::HairSimulation> make_simulation(const Context& ctx, const 
   switch (h.model) {
     case HairModel::Anjyo1992: return hair::make_anjyo1992(ctx, h.dynamics, setup);
     case HairModel::Daldegan1993: return hair::make_daldegan1993(ctx, h.daldegan, setup);
+    case HairModel::Bando2003: return hair::make_bando2003(ctx, h.bando, setup);
   }
   fail("unknown hair model");
+}
+
+// Whether the model's state at t = 0 differs from the groom (it settles before frame 0), so a
+// still scene must run the model instead of showing the groom.
+bool settles_before_start(const HairGroupSpec& h) {
+  switch (h.model) {
+    case HairModel::Anjyo1992: return false;
+    case HairModel::Daldegan1993: return h.daldegan.settle_time > 0.0;
+    case HairModel::Bando2003: return h.bando.settle_time > 0.0;
+  }
+  return false;
 }
 
 }  // namespace
@@ -222,15 +234,21 @@ std::vector<Vec3> Session::hair_root_targets(std::size_t gi, int frame) {
   auto& g = hair_runtime().groups[gi];
   const std::size_t mi = mesh_index(m_scene.hair[gi].mesh);
   const auto motion = head_motion_transform(frame);
-  std::vector<Vec3> pts;
+  geom::TriMesh rest = *mesh(mi);
+  rest.transform(m_scene.assets.meshes[mi].transform.matrix());
+  std::vector<Vec3> pts, at_rest;
   if (g.skin_rig) {
     geom::TriMesh now = *skin_mesh(*g.skin_rig, frame);
     now.transform(m_scene.assets.meshes[mi].transform.matrix());
     pts = hair::bound_root_positions(g.skin_binding, now);
+    at_rest = g.skin_rest_roots;
   } else {
-    geom::TriMesh rest = *mesh(mi);
-    rest.transform(m_scene.assets.meshes[mi].transform.matrix());
     pts = hair::bound_root_positions(*groom, rest);
+    at_rest = pts;
+  }
+  for (std::size_t s = 0; s < pts.size(); ++s) {  // the root's rest offset from its binding
+    const Vec3 root = groom->strands.points[groom->strands.strand_begin(s)].cast<double>();
+    pts[s] += root - at_rest[s];
   }
   if (motion)
     for (auto& p : pts) p = *motion * p;
@@ -293,8 +311,8 @@ std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int
 
   build_hair_group(gi);
   if (g.last && g.last_frame == frame) return g.last;
-  // A still scene shows the groom at rest, or the Daldegan model's settled pose.
-  const bool settles = h.model == HairModel::Daldegan1993 && h.daldegan.settle_time > 0.0;
+  // A still scene shows the groom at rest, or the model's settled pose.
+  const bool settles = settles_before_start(h);
   if (!m_scene.animation && !settles) {
     if (!g.skin_rig) return g.styled;
     auto on_skin = std::make_shared<geom::StrandSet>(*g.styled);

@@ -1,12 +1,15 @@
 // Grooms as assets (issue 20, ADR 0010): assets.grooms[] loads strand files with units and a
 // transform, hair[].groom runs them with any model, errors name the JSON path, the strand cache
 // works for imported grooms.
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/geom/strand_io.hpp"
 #include "follicle/scene/session.hpp"
@@ -165,4 +168,43 @@ TEST(GroomScene, RootsRideAFaceChangingExpression) {
   }
   EXPECT_LT(drift, 1e-4);
   EXPECT_GT(moved, 1e-3);  // the surprised brow lifts the hairline by millimetres
+}
+
+TEST(GroomScene, EveryModelRunsTheSameGroomAndCachesItThreadIndependently) {
+  // One imported groom, each hair model in turn (ADR 0010): frame 0 is the groom, the shake moves
+  // it, and the strand cache written with 1 and with 2 threads holds the same bytes.
+  const auto dir = test::scratch_dir("groom_scene_models");
+  const auto file = dir / "bob.hair";
+  const geom::StrandSet ref = write_bob_groom(file, Context(2, 1));
+  for (const char* model : {"anjyo1992", "daldegan1993", "bando2003"}) {
+    Json j = groom_scene(file, "mm");
+    j["hair"][0]["model"] = model;
+    j["hair"][0]["daldegan"]["guides"] = 100;
+    j["hair"][0]["daldegan"]["guide_segments"] = 10;
+    j["hair"][0]["bando"]["spacing"] = 0.015;
+    std::map<std::string, std::string> bytes[2];  // cache file (relative) -> contents
+    for (int threads : {1, 2}) {
+      const Context ctx(threads, 1);
+      Session s = Session::from_json(j, scenes_dir(), "g.json", ctx);
+      const auto cache = dir / fmt::format("cache_{}_{}", model, threads);
+      std::filesystem::remove_all(cache);
+      s.set_strand_cache(cache);
+      const auto f0 = s.hair_strands(0, 0);
+      ASSERT_EQ(f0->num_strands(), ref.num_strands()) << model;
+      for (std::size_t i = 0; i < ref.num_points(); i += 7)
+        ASSERT_LT((f0->points[i] - ref.points[i]).norm(), 1e-4f) << model << " " << i;
+      const auto f3 = s.hair_strands(0, 3);
+      double moved = 0;
+      for (std::size_t i = 0; i < ref.num_points(); ++i)
+        moved = std::max(moved, double((f3->points[i] - ref.points[i]).norm()));
+      EXPECT_GT(moved, 1e-3) << model;
+      EXPECT_EQ(s.hair_stats().cache_writes, 4u) << model;
+      for (const auto& e : std::filesystem::recursive_directory_iterator(cache))
+        if (e.path().extension() == ".fsc")
+          bytes[threads - 1][std::filesystem::relative(e.path(), cache).string()] =
+              read_file(e.path());
+    }
+    EXPECT_EQ(bytes[0].size(), 4u) << model;
+    EXPECT_TRUE(bytes[0] == bytes[1]) << model << ": the cache differs between 1 and 2 threads";
+  }
 }
