@@ -22,6 +22,13 @@ int report(const std::string& msg, int code) {
   return code;
 }
 
+// Output paths must name something: `-o ''` used to fall back silently to the scene's outputs.
+CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& v) { return v.empty() ? std::string("an empty path names no file") : ""; },
+      "PATH", "non-empty path");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -41,7 +48,8 @@ int main(int argc, char** argv) {
   RenderArgs ra;
   auto* render = app.add_subcommand("render", "render a scene to PNG");
   render->add_option("scene", ra.scene, "scene file (.json)")->required();
-  render->add_option("-o,--output", ra.output, "output PNG (default: the scene's outputs)");
+  render->add_option("-o,--output", ra.output, "output PNG (default: the scene's outputs)")
+      ->check(non_empty_path());
   render->add_option("--width", ra.width, "image width in pixels (overrides the scene)")
       ->check(CLI::Range(1, 16384));
   render->add_option("--height", ra.height, "image height in pixels (overrides the scene)")
@@ -93,7 +101,8 @@ int main(int argc, char** argv) {
       "write a scene's hair to a strand file, its wrinkle maps to images or its deformed face "
       "mesh");
   exp->add_option("scene", ea.scene, "scene file (.json)")->required();
-  exp->add_option("--hair", ea.hair, "output strand file: .hair, .tfx, .usda or .obj");
+  exp->add_option("--hair", ea.hair, "output strand file: .hair, .tfx, .usda or .obj")
+      ->check(non_empty_path());
   exp->add_option("--maps", ea.maps,
                   "folder for height, normal and displacement maps (EXR + PNG) of the rest "
                   "state and each frame");
@@ -112,8 +121,10 @@ int main(int argc, char** argv) {
       "compare", "distances between two meshes (mean, RMS, p95, max) and an error render");
   compare->add_option("a", cma.a, "first mesh (.obj, .ply, .gltf, .glb)")->required();
   compare->add_option("b", cma.b, "second mesh")->required();
-  compare->add_option("-o,--output", cma.output,
-                      "PNG of A coloured by its distance to B (blue 0 .. red max)");
+  compare
+      ->add_option("-o,--output", cma.output,
+                   "PNG of A coloured by its distance to B (blue 0 .. red max)")
+      ->check(non_empty_path());
   compare->add_option("--units", cma.units, "length unit of both files and of the printed numbers")
       ->capture_default_str();
   compare->add_option("--width", cma.width, "width of the error render")
@@ -131,8 +142,11 @@ int main(int argc, char** argv) {
   animate->add_option("scene", aa.scene, "scene file (.json) with an \"animation\" section")
       ->required();
   animate->add_option("--frames", aa.frames, "frame range A-B (default: every frame)");
-  animate->add_option("-o,--output", aa.output_dir, "output folder for frame_NNNN.png")->required();
-  animate->add_option("--mp4", aa.mp4, "MP4 file (default: DIR/<scene>.mp4)");
+  animate->add_option("-o,--output", aa.output_dir, "output folder for frame_NNNN.png")
+      ->required()
+      ->check(non_empty_path());
+  animate->add_option("--mp4", aa.mp4, "MP4 file (default: DIR/<scene>.mp4)")
+      ->check(non_empty_path());
   animate->add_option("--cache", aa.cache, "strand cache folder: re-render without re-simulating");
   animate->add_flag("--no-video", aa.no_video, "write only the PNG frames");
   animate->add_option("--width", aa.width, "image width in pixels (overrides the scene)")
@@ -154,8 +168,8 @@ int main(int argc, char** argv) {
                       "frames pictured on the sheet f1,f2,... (default: first, middle, last)");
   harness->add_option("--thumb-size", ha.thumb_size, "width of each picture in pixels")
       ->capture_default_str();
-  harness->add_option("--json", ha.json, "report file (.json)");
-  harness->add_option("--sheet", ha.sheet, "comparison sheet (.png)");
+  harness->add_option("--json", ha.json, "report file (.json)")->check(non_empty_path());
+  harness->add_option("--sheet", ha.sheet, "comparison sheet (.png)")->check(non_empty_path());
 
   DocsArgs da;
   auto* docs = app.add_subcommand("docs", "");  // hidden: an empty group hides it from --help

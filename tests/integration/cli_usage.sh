@@ -27,6 +27,8 @@ check unknown-flag 2 "$FOLLICLE" validate --frobnicate "$ROOT/data/scenes/defaul
 check missing-arg 2 "$FOLLICLE" validate
 check bad-width 2 "$FOLLICLE" render "$ROOT/data/scenes/default.json" -o "$TMP/x.png" --width -3
 check not-png 2 "$FOLLICLE" render "$ROOT/data/scenes/default.json" -o "$TMP/x.jpg"
+check empty-output 2 "$FOLLICLE" render "$ROOT/data/scenes/default.json" -o ''
+check empty-export-hair 2 "$FOLLICLE" export "$ROOT/data/scenes/anjyo_bob.json" --hair ''
 check bad-size 2 "$FOLLICLE" bench foo --size nonsense
 check bad-units 1 "$FOLLICLE" info "$ROOT/data/meshes/lee_perry_smith/head.obj" --units inch
 check unknown-file-type 1 "$FOLLICLE" info "$ROOT/data/CREDITS.md"

@@ -1,7 +1,10 @@
 #include "follicle/core/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -15,7 +18,9 @@ void write_atomically(const std::filesystem::path& path,
   if (path.has_parent_path()) {
     std::error_code ec;
     fs::create_directories(path.parent_path(), ec);
-    if (ec) fail_at(path.string(), "cannot create directory: {}", ec.message());
+    if (ec)
+      fail_at(path.string(), "cannot create directory {}: {}", path.parent_path().string(),
+              ec.message());
   }
   fs::path tmp = path;
   tmp += ".tmp-" + std::to_string(::getpid());
@@ -29,18 +34,38 @@ void write_atomically(const std::filesystem::path& path,
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(tmp, ec);
-    fail_at(path.string(), "cannot move finished output into place");
+    fail_at(path.string(), "cannot move finished output into place: {}", why);
   }
 }
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes) {
+  // POSIX calls rather than std::ofstream: every write, the flush to the disk and the close are
+  // checked and their errno reported (a stream on a full disk may fail only at close, and says
+  // nothing about why). Errors name the requested path, not the temporary one.
   write_atomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) fail_at(tmp.string(), "cannot open for writing");
-    f.write(bytes.data(), std::streamsize(bytes.size()));
-    f.close();
-    if (!f) fail_at(tmp.string(), "write failed (disk full?)");
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) fail_at(path.string(), "cannot open for writing: {}", std::strerror(errno));
+    const char* p = bytes.data();
+    std::size_t left = bytes.size();
+    while (left > 0) {
+      const ssize_t n = ::write(fd, p, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const int err = n < 0 ? errno : ENOSPC;
+        ::close(fd);
+        fail_at(path.string(), "write failed: {}", std::strerror(err));
+      }
+      p += n;
+      left -= std::size_t(n);
+    }
+    if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+      const int err = errno;
+      ::close(fd);
+      fail_at(path.string(), "write failed: {}", std::strerror(err));
+    }
+    if (::close(fd) != 0) fail_at(path.string(), "write failed: {}", std::strerror(errno));
   });
 }
 

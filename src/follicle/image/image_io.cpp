@@ -44,12 +44,17 @@ Image<uint8_t, C> read_stb(const std::filesystem::path& path) {
 template <int C>
 void write_stb_png(const std::filesystem::path& path, const Image<uint8_t, C>& img) {
   if (img.empty()) fail_at(path.string(), "cannot write an empty image");
-  write_atomically(path, [&](const std::filesystem::path& tmp) {
-    if (!stbi_write_png(tmp.string().c_str(), img.width(), img.height(), C, img.data(),
-                        img.width() * C)) {
-      fail_at(path.string(), "cannot write PNG");
-    }
-  });
+  // Encoded in memory, then written with every write checked (stbi_write_png's own file path
+  // ignores fwrite/fclose errors and left truncated PNGs on a full disk).
+  std::string bytes;
+  const auto append = [](void* ctx, void* data, int size) {
+    static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), std::size_t(size));
+  };
+  if (!stbi_write_png_to_func(append, &bytes, img.width(), img.height(), C, img.data(),
+                              img.width() * C) ||
+      bytes.empty())
+    fail_at(path.string(), "cannot encode PNG");
+  write_file_atomically(path, bytes);
 }
 
 template <int C>

@@ -162,7 +162,9 @@ struct HairGroupSpec {
                 "daldegan1993 "
                 "hair uses its styler materials and eq. (7)"});
     v("render", render, ParamInfo{"how the strands are drawn"});
-    v("seed", seed, ParamInfo{"random seed of pores, lengths, k_a and fluctuation"});
+    v("seed", seed,
+      ParamInfo{"random seed of pores, lengths, k_a and fluctuation, of the HairStyler (unless "
+                "styler.seed is given) and of the bando2003 strand choice"});
   }
 };
 

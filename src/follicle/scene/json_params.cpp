@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <functional>
 #include <set>
 
@@ -61,6 +62,22 @@ Json parse_json_text(const std::string& text, const std::string& file_for_errors
       msg = msg.substr(b + 2);
     }
     fail_at(fmt::format("{}:{}:{}", file, line, col), "invalid JSON: {}", msg);
+  } catch (const Json::out_of_range& e) {
+    // A number too large for a double ("1e999"): nlohmann gives no position, only the text of
+    // the number, so the number is looked up in the text for its line and column.
+    std::string msg = e.what();
+    if (auto b = msg.find("] "); b != std::string::npos) msg = msg.substr(b + 2);
+    std::string where = file;
+    const auto q0 = msg.find('\''), q1 = msg.rfind('\'');
+    if (q0 != std::string::npos && q1 > q0 + 1) {
+      if (const auto at = text.find(msg.substr(q0 + 1, q1 - q0 - 1)); at != std::string::npos) {
+        const std::size_t line = 1 + std::size_t(std::count(text.begin(), text.begin() + at, '\n'));
+        const auto nl = text.rfind('\n', at);
+        const std::size_t col = at - (nl == std::string::npos ? 0 : nl + 1) + 1;
+        where = fmt::format("{}:{}:{}", file, line, col);
+      }
+    }
+    fail_at(where, "invalid JSON: {} (larger than a double can hold)", msg);
   }
 }
 

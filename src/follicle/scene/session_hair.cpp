@@ -183,7 +183,8 @@ void Session::build_hair_group(std::size_t gi) {
       const Vec3 up = g.hull.rotation.col(1), front = g.hull.rotation.col(2);
       hair::HairStylerParams sp = hs.styler->resolve(world, up, front, path, src);
       sp.density_scale *= hs.density_scale;
-      if (sp.seed == 1) sp.seed = hs.seed;
+      // The group's seed drives the styler unless the styler object names its own.
+      if (!hs.styler->overrides.contains("seed")) sp.seed = hs.seed;
       hair::StylerInputs inputs;
       try {
         inputs = hair::load_styler_inputs(sp, [&](const std::string& f) { return resolve(f); });

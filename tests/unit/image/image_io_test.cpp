@@ -1,12 +1,15 @@
 #include "follicle/image/image_io.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
+#include <csignal>
 #include <fstream>
 #include <limits>
 
 #include "follicle/core/atomic_file.hpp"
+#include "follicle/core/error.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
@@ -134,4 +137,58 @@ TEST(ImageIo, WritingEmptyImageIsErrorAndLeavesNoFile) {
   EXPECT_THROW(write_exr(dir / "e.exr", ImageF{}), Error);
   EXPECT_FALSE(std::filesystem::exists(dir / "e.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "e.exr"));
+}
+
+namespace {
+
+// Lowers the file-size limit (RLIMIT_FSIZE) so writes past `bytes` fail with EFBIG, like a disk
+// that fills up; SIGXFSZ is ignored so the write returns the error instead of killing the test.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &m_old);
+    m_old_handler = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit lim = m_old;
+    lim.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &lim);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &m_old);
+    std::signal(SIGXFSZ, m_old_handler);
+  }
+
+ private:
+  rlimit m_old{};
+  void (*m_old_handler)(int) = nullptr;
+};
+
+}  // namespace
+
+TEST(ImageIO, AWriteThatRunsOutOfSpaceFailsNamingThePathAndLeavesNoFile) {
+  // Regression: on a full disk `follicle render` printed "wrote ..." and left a PNG without its
+  // end chunk (stbi_write_png ignored fwrite errors).
+  const auto dir = test::scratch_dir("png_full_disk");
+  const auto file = dir / "noise.png";
+  ImageRGBA8 img(256, 256);
+  uint32_t x = 12345;
+  for (auto& v : img.storage())
+    v = uint8_t((x = x * 1664525u + 1013904223u) >> 24);  // incompressible
+  std::string message;
+  {
+    const FileSizeLimit limit(4096);
+    try {
+      write_png(file, img);
+    } catch (const Error& e) {
+      message = e.what();
+    }
+  }
+  ASSERT_FALSE(message.empty()) << "a write past the size limit was reported as success";
+  EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+  EXPECT_EQ(message.find(".tmp-"), std::string::npos) << message;  // not the temporary name
+  EXPECT_NE(message.find("write failed: File too large"), std::string::npos) << message;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    ADD_FAILURE() << "left behind: " << e.path();
+  // Without the limit the same image is written and reads back.
+  write_png(file, img);
+  EXPECT_EQ(read_png_rgba(file).storage(), img.storage());
 }

@@ -174,6 +174,20 @@ TEST(JsonParse, SyntaxErrorHasLineAndColumn) {
   }
 }
 
+TEST(JsonParse, ANumberTooLargeForADoubleNamesFileLineAndColumn) {
+  // Regression: "1e999" printed nlohmann's raw out_of_range exception without file or line.
+  try {
+    parse_json_text("{\n  \"a\": 1,\n  \"seed\": 1e999\n}\n", "big.json");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_THAT(m, HasSubstr("big.json:3:11"));
+    EXPECT_THAT(m, HasSubstr("1e999"));
+    EXPECT_THAT(m, HasSubstr("invalid JSON"));
+    EXPECT_THAT(m, ::testing::Not(HasSubstr("json.exception")));
+  }
+}
+
 TEST(JsonParse, DuplicateKeyIsAnError) {
   EXPECT_THROW(parse_json_text(R"({"a": 1, "a": 2})", "dup.json"), Error);
   // The same key in different objects is fine.
