@@ -414,8 +414,11 @@ std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int
     return e;
   };
   auto positions_at = [&](int f) {
+    // Placed by the head pose at the frame's time, like the meshes: the model's own time may
+    // differ from it by up to half a step (a frame time that is no multiple of its step), which
+    // would shift the whole hair off a moving head on such frames.
     auto out = std::make_shared<geom::StrandSet>();
-    g.sim->strands(head_at(g.sim->time()), *out);
+    g.sim->strands(head_at(frame_time(f)), *out);
     ride_skin(gi, f, *out);
     if (use_cache) {
       hair::StrandFrame sf;
