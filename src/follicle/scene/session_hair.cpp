@@ -62,7 +62,7 @@ namespace {
 // Everything the cached strands depend on; a cache made with other settings is discarded.
 std::string cache_key(const Scene& s) {
   Json k = Json::object();
-  k["cache_format"] = 1;
+  k["cache_format"] = 2;  // 2: strands placed by the head pose at the frame time
   k["hair"] = to_json(s.hair);
   k["animation"] = to_json(s.animation);
   k["meshes"] = to_json(s.assets.meshes);
