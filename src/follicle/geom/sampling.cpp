@@ -59,6 +59,45 @@ double poisson_disc_distance_for_count(double area, std::size_t n) {
   return std::sqrt(0.7 * area / double(n));
 }
 
+std::vector<uint32_t> poisson_disc_accept(const std::vector<Vec3>& points, double r,
+                                          std::size_t max_points) {
+  if (!(r > 0) || !std::isfinite(r)) fail("poisson_disc_accept: distance must be > 0, got {}", r);
+  // Dart throwing in the given order (serial: acceptance depends on earlier decisions).
+  // Hash grid with cells of edge r: a conflicting sample lies in the 27 surrounding cells.
+  const double inv = 1.0 / r;
+  auto key = [](int64_t x, int64_t y, int64_t z) {
+    return (uint64_t(x) * 73856093ull) ^ (uint64_t(y) * 19349663ull) ^ (uint64_t(z) * 83492791ull);
+  };
+  struct Cell {
+    int64_t x, y, z;
+  };
+  std::unordered_multimap<uint64_t, uint32_t> grid;
+  std::vector<uint32_t> out;
+  const double r2 = r * r;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    const Vec3 q = p * inv;
+    const Cell cc{int64_t(std::floor(q.x())), int64_t(std::floor(q.y())),
+                  int64_t(std::floor(q.z()))};
+    bool ok = true;
+    for (int64_t dz = -1; dz <= 1 && ok; ++dz)
+      for (int64_t dy = -1; dy <= 1 && ok; ++dy)
+        for (int64_t dx = -1; dx <= 1 && ok; ++dx) {
+          auto [b, e] = grid.equal_range(key(cc.x + dx, cc.y + dy, cc.z + dz));
+          for (auto it = b; it != e; ++it)
+            if ((points[it->second] - p).squaredNorm() < r2) {
+              ok = false;
+              break;
+            }
+        }
+    if (!ok) continue;
+    grid.emplace(key(cc.x, cc.y, cc.z), uint32_t(i));
+    out.push_back(uint32_t(i));
+    if (max_points && out.size() >= max_points) break;
+  }
+  return out;
+}
+
 std::vector<SurfaceSample> sample_poisson_disc(const Context& ctx, const TriMesh& mesh,
                                                const PoissonDiscParams& params, uint64_t seed) {
   params.validate();
@@ -71,38 +110,11 @@ std::vector<SurfaceSample> sample_poisson_disc(const Context& ctx, const TriMesh
         "max_candidates {}",
         r, sampler.total_area(), want, params.max_candidates);
   const auto candidates = sample_uniform(ctx, mesh, std::size_t(std::max(1.0, want)), seed);
-  // Dart throwing in candidate order (serial: acceptance depends on earlier decisions).
-  // Hash grid with cells of edge r: a conflicting sample lies in the 27 surrounding cells.
-  const double inv = 1.0 / r;
-  auto key = [](int64_t x, int64_t y, int64_t z) {
-    return (uint64_t(x) * 73856093ull) ^ (uint64_t(y) * 19349663ull) ^ (uint64_t(z) * 83492791ull);
-  };
-  struct Cell {
-    int64_t x, y, z;
-  };
-  std::unordered_multimap<uint64_t, uint32_t> grid;
+  std::vector<Vec3> points(candidates.size());
+  for (std::size_t i = 0; i < candidates.size(); ++i) points[i] = candidates[i].point;
   std::vector<SurfaceSample> out;
-  const double r2 = r * r;
-  for (const SurfaceSample& c : candidates) {
-    const Vec3 q = c.point * inv;
-    const Cell cc{int64_t(std::floor(q.x())), int64_t(std::floor(q.y())),
-                  int64_t(std::floor(q.z()))};
-    bool ok = true;
-    for (int64_t dz = -1; dz <= 1 && ok; ++dz)
-      for (int64_t dy = -1; dy <= 1 && ok; ++dy)
-        for (int64_t dx = -1; dx <= 1 && ok; ++dx) {
-          auto [b, e] = grid.equal_range(key(cc.x + dx, cc.y + dy, cc.z + dz));
-          for (auto it = b; it != e; ++it)
-            if ((out[it->second].point - c.point).squaredNorm() < r2) {
-              ok = false;
-              break;
-            }
-        }
-    if (!ok) continue;
-    grid.emplace(key(cc.x, cc.y, cc.z), uint32_t(out.size()));
-    out.push_back(c);
-    if (params.max_points && out.size() >= params.max_points) break;
-  }
+  for (uint32_t i : poisson_disc_accept(points, params.min_distance, params.max_points))
+    out.push_back(candidates[i]);
   return out;
 }
 

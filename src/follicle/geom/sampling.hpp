@@ -54,6 +54,12 @@ struct PoissonDiscParams {
   void validate() const { validate_params(*this, "poisson_disc"); }
 };
 
+/// Dart throwing over given points: the indices of the points accepted, in order, when no
+/// earlier accepted point lies within r (Euclidean; hash grid of cell r). Stops after max_points
+/// accepted points (0 = no limit). Throws follicle::Error for r <= 0.
+std::vector<uint32_t> poisson_disc_accept(const std::vector<Vec3>& points, double r,
+                                          std::size_t max_points = 0);
+
 /// Poisson-disc samples: area-uniform candidates are accepted in order when no accepted sample
 /// lies within min_distance (hash-grid test). Deterministic for a given seed.
 std::vector<SurfaceSample> sample_poisson_disc(const Context& ctx, const TriMesh& mesh,

@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/log.hpp"
 #include "follicle/core/rng.hpp"
+#include "follicle/geom/sampling.hpp"
 
 namespace follicle::hair {
 
@@ -25,9 +25,8 @@ void BandoParams::validate() const {
 
 namespace {
 
-// Step 1: the strands whose roots are at least r apart, greedily in a seeded random order (a
-// Poisson-disc subset of the roots; a hashed grid of cell r finds the accepted roots near a
-// candidate).
+// Step 1: the strands whose roots are at least r apart: Poisson-disc darts over the roots in a
+// seeded random order.
 std::vector<uint32_t> spaced_strands(const geom::StrandSet& s, double r, uint64_t seed) {
   const std::size_t n = s.num_strands();
   std::vector<uint64_t> key(n);
@@ -36,36 +35,10 @@ std::vector<uint32_t> spaced_strands(const geom::StrandSet& s, double r, uint64_
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(),
             [&](uint32_t a, uint32_t b) { return key[a] != key[b] ? key[a] < key[b] : a < b; });
-  auto cell = [&](const Vec3& p) {
-    return Eigen::Vector3i(int(std::floor(p.x() / r)), int(std::floor(p.y() / r)),
-                           int(std::floor(p.z() / r)));
-  };
-  auto hash = [](const Eigen::Vector3i& c) {
-    return (uint64_t(uint32_t(c.x())) * 73856093ull) ^ (uint64_t(uint32_t(c.y())) * 19349663ull) ^
-           (uint64_t(uint32_t(c.z())) * 83492791ull);
-  };
-  std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+  std::vector<Vec3> roots(n);
+  for (std::size_t k = 0; k < n; ++k) roots[k] = s.points[s.strand_begin(order[k])].cast<double>();
   std::vector<uint32_t> out;
-  const double r2 = r * r;
-  for (uint32_t i : order) {
-    const Vec3 p = s.points[s.strand_begin(i)].cast<double>();
-    const Eigen::Vector3i c = cell(p);
-    bool ok = true;
-    for (int dz = -1; dz <= 1 && ok; ++dz)
-      for (int dy = -1; dy <= 1 && ok; ++dy)
-        for (int dx = -1; dx <= 1 && ok; ++dx) {
-          const auto it = grid.find(hash(c + Eigen::Vector3i(dx, dy, dz)));
-          if (it == grid.end()) continue;
-          for (uint32_t j : it->second)
-            if ((s.points[s.strand_begin(j)].cast<double>() - p).squaredNorm() < r2) {
-              ok = false;
-              break;
-            }
-        }
-    if (!ok) continue;
-    grid[hash(c)].push_back(i);
-    out.push_back(i);
-  }
+  for (uint32_t k : geom::poisson_disc_accept(roots, r)) out.push_back(order[k]);
   std::sort(out.begin(), out.end());  // chains in groom order
   return out;
 }

@@ -233,23 +233,18 @@ void Session::build_hair_group(std::size_t gi) {
 std::vector<Vec3> Session::hair_root_targets(std::size_t gi, int frame) {
   const auto groom = hair_groom(gi);
   auto& g = hair_runtime().groups[gi];
-  const std::size_t mi = mesh_index(m_scene.hair[gi].mesh);
   const auto motion = head_motion_transform(frame);
-  geom::TriMesh rest = *mesh(mi);
-  rest.transform(m_scene.assets.meshes[mi].transform.matrix());
-  std::vector<Vec3> pts, at_rest;
+  // Each root at its rest place (the groom's root, which may sit off the surface), moved by the
+  // skin's displacement of its binding point when the mesh has a skin rig.
+  std::vector<Vec3> pts(groom->num_strands());
+  for (std::size_t s = 0; s < pts.size(); ++s)
+    pts[s] = groom->strands.points[groom->strands.strand_begin(s)].cast<double>();
   if (g.skin_rig) {
+    const std::size_t mi = mesh_index(m_scene.hair[gi].mesh);
     geom::TriMesh now = *skin_mesh(*g.skin_rig, frame);
     now.transform(m_scene.assets.meshes[mi].transform.matrix());
-    pts = hair::bound_root_positions(g.skin_binding, now);
-    at_rest = g.skin_rest_roots;
-  } else {
-    pts = hair::bound_root_positions(*groom, rest);
-    at_rest = pts;
-  }
-  for (std::size_t s = 0; s < pts.size(); ++s) {  // the root's rest offset from its binding
-    const Vec3 root = groom->strands.points[groom->strands.strand_begin(s)].cast<double>();
-    pts[s] += root - at_rest[s];
+    const auto bound = hair::bound_root_positions(g.skin_binding, now);
+    for (std::size_t s = 0; s < pts.size(); ++s) pts[s] += bound[s] - g.skin_rest_roots[s];
   }
   if (motion)
     for (auto& p : pts) p = *motion * p;
