@@ -8,6 +8,8 @@ PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libegl-dev libopengl-dev libgl1-mesa-dri libglfw3-dev libimgui-dev
   xvfb xauth xdotool ffmpeg
+  python3-dev pybind11-dev python3-numpy python3-pytest
+  blender
 )
 missing=()
 for p in "${PKGS[@]}"; do

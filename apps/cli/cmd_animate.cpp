@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "follicle/core/atomic_file.hpp"
+#include "follicle/core/interrupt.hpp"
 #include "follicle/core/log.hpp"
 #include "follicle/core/progress.hpp"
 #include "follicle/image/image_io.hpp"
@@ -48,6 +49,7 @@ int run_process(const std::vector<std::string>& args) {
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }
+  const InterruptCleanupChild stop_on_interrupt(pid);  // SIGINT / SIGTERM stop it first
   int status = 0;
   if (::waitpid(pid, &status, 0) < 0) return 127;
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;

@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "follicle/core/error.hpp"
+#include "follicle/core/interrupt.hpp"
 
 namespace {
 
@@ -33,6 +34,8 @@ CLI::Validator non_empty_path() {
 
 int main(int argc, char** argv) {
   using namespace follicle::cli;
+  // SIGINT / SIGTERM remove the temporary file of an output being written and stop ffmpeg.
+  follicle::install_interrupt_handlers();
   CLI::App app{"follicle: model, animate and render virtual heads (skin wrinkles and hair)",
                "follicle"};
   app.require_subcommand(1);

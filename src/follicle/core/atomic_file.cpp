@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "follicle/core/error.hpp"
+#include "follicle/core/interrupt.hpp"
 
 namespace follicle {
 
@@ -24,6 +25,7 @@ void write_atomically(const std::filesystem::path& path,
   }
   fs::path tmp = path;
   tmp += ".tmp-" + std::to_string(::getpid());
+  const InterruptCleanupFile cleanup(tmp);  // SIGINT / SIGTERM remove it too
   try {
     write(tmp);
   } catch (...) {

@@ -134,8 +134,22 @@ class Session {
 
   /// Face rigs ("skin" section, session_skin.cpp). The rig of skin[rig] (built on first use).
   const skin::FaceRig& face_rig(std::size_t rig);
-  /// The muscle pose of skin[rig] at `frame`: its expression, or its contraction track sampled.
+  /// The muscle pose of skin[rig] at `frame`: the pose set by set_skin_pose if any, else its
+  /// expression, or its contraction track sampled.
   skin::MusclePose skin_pose(std::size_t rig, int frame);
+  /// Scripting (Python, the viewer): replaces the pose of skin[rig] at every frame until
+  /// clear_skin_pose: `expression` (of the face-setup file) * `weight`, then the named
+  /// `contractions` and the jaw angle [rad] when given. Unknown names throw follicle::Error with
+  /// the names the setup has. Frames computed afterwards (the skin mesh, the hair riding it) use
+  /// it; the strand cache is neither read nor written while any rig's pose is set.
+  void set_skin_pose(std::size_t rig, const std::string& expression, double weight,
+                     const std::map<std::string, double>& contractions = {},
+                     std::optional<double> jaw_angle = std::nullopt);
+  /// Back to the scene file's pose (expression or track) for skin[rig].
+  void clear_skin_pose(std::size_t rig);
+  /// Muscle and expression names of skin[rig]'s face setup (in the setup file's order).
+  std::vector<std::string> skin_muscle_names(std::size_t rig);
+  std::vector<std::string> skin_expression_names(std::size_t rig);
   /// The deformed, wrinkled mesh of skin[rig] at `frame` (mesh-file coordinates in metres, the
   /// asset transform NOT applied; normals of the deformed surface). Cached per frame.
   std::shared_ptr<const geom::TriMesh> skin_mesh(std::size_t rig, int frame);
@@ -171,6 +185,9 @@ class Session {
   void resolve_skin(std::size_t rig);
   void validate_skin_files() const;
   void apply_skin(std::size_t asset, render::MeshItem& item, int frame);
+  bool skin_pose_overridden() const;
+  void forget_frames_of_rig(std::size_t rig);
+  void skin_forget_last(std::size_t rig);
 };
 
 }  // namespace follicle::scene

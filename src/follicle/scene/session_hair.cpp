@@ -230,6 +230,17 @@ void Session::build_hair_group(std::size_t gi) {
                     g.styled->num_points());
 }
 
+void Session::forget_frames_of_rig(std::size_t ri) {
+  // The skin mesh of the rig and every hair frame riding it were made with the old pose.
+  skin_forget_last(ri);
+  if (!m_hair) return;
+  for (auto& g : m_hair->groups)
+    if (g.skin_rig == ri) {
+      g.last.reset();
+      g.last_frame = -1;
+    }
+}
+
 std::vector<Vec3> Session::hair_root_targets(std::size_t gi, int frame) {
   const auto groom = hair_groom(gi);
   auto& g = hair_runtime().groups[gi];
@@ -328,7 +339,7 @@ std::shared_ptr<const geom::StrandSet> Session::hair_strands(std::size_t gi, int
   }
 
   // Strand cache: check (or start) it once; frames found there are not simulated.
-  const bool use_cache = !rt.cache_dir.empty();
+  const bool use_cache = !rt.cache_dir.empty() && !skin_pose_overridden();
   if (use_cache && !rt.cache_ready) {
     const std::string key = cache_key(m_scene);
     const auto key_file = rt.cache_dir / "cache_key.json";

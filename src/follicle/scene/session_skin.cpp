@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "follicle/core/error.hpp"
@@ -25,11 +26,9 @@ std::vector<std::string> expression_names(const skin::MuscleSet& set) {
   return out;
 }
 
-// expression * weight, then explicit contractions and jaw angle; errors name the JSON path.
-skin::MusclePose resolve_pose(const skin::MuscleSet& set, const std::string& expression,
-                              double weight, const std::map<std::string, double>& contractions,
-                              const std::optional<double>& jaw, const JsonSource& src,
-                              const std::string& path, const std::string& setup_file) {
+skin::MusclePose expression_pose(const skin::MuscleSet& set, const std::string& expression,
+                                 double weight, const JsonSource& src, const std::string& path,
+                                 const std::string& setup_file) {
   const skin::Expression* expr = nullptr;
   for (const auto& e : set.expressions)
     if (e.name == expression) expr = &e;
@@ -41,7 +40,21 @@ skin::MusclePose resolve_pose(const skin::MuscleSet& set, const std::string& exp
                   (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") + "; " + setup_file +
                   " has " + detail::quoted_list(names));
   }
-  skin::MusclePose pose = skin::pose_from_expression(set, *expr, weight);
+  return skin::pose_from_expression(set, *expr, weight);
+}
+
+// expression * weight (none when `expression` is empty: every muscle relaxed), then explicit
+// contractions and jaw angle; errors name the JSON path.
+skin::MusclePose resolve_pose(const skin::MuscleSet& set, const std::string& expression,
+                              double weight, const std::map<std::string, double>& contractions,
+                              const std::optional<double>& jaw, const JsonSource& src,
+                              const std::string& path, const std::string& setup_file) {
+  skin::MusclePose pose;
+  if (expression.empty()) {
+    pose.contractions.assign(set.num_muscles(), 0.0);
+  } else {
+    pose = expression_pose(set, expression, weight, src, path, setup_file);
+  }
   for (const auto& [name, k] : contractions) {
     int idx = -1;
     try {
@@ -222,6 +235,7 @@ skin::MusclePose Session::skin_pose(std::size_t ri, int frame) {
   if (frame < 0) fail("frame {} is negative", frame);
   resolve_skin(ri);
   const auto& r = skin_runtime().rigs[ri];
+  if (r.pose_override) return *r.pose_override;
   if (r.muscle_tracks.empty()) return r.static_pose;
   const double t = frame_time(frame);
   skin::MusclePose pose;
@@ -234,12 +248,66 @@ skin::MusclePose Session::skin_pose(std::size_t ri, int frame) {
 std::shared_ptr<const geom::TriMesh> Session::skin_mesh(std::size_t ri, int frame) {
   const skin::FaceRig& rig = face_rig(ri);
   auto& r = skin_runtime().rigs[ri];
-  const bool still = r.muscle_tracks.empty();
+  const bool still = r.muscle_tracks.empty() || r.pose_override.has_value();
   if (r.last && (r.last_frame == frame || (still && r.last_frame == -2))) return r.last;
   rig.update(*m_ctx, skin_pose(ri, frame), r.state);
   r.last = std::make_shared<const geom::TriMesh>(rig.deformed_mesh(r.state));
   r.last_frame = still ? -2 : frame;
   return r.last;
+}
+
+void Session::set_skin_pose(std::size_t ri, const std::string& expression, double weight,
+                            const std::map<std::string, double>& contractions,
+                            std::optional<double> jaw_angle) {
+  if (ri >= m_scene.skin.size())
+    fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
+  if (!std::isfinite(weight)) fail("skin[{}]: expression weight is not finite", ri);
+  for (const auto& [name, k] : contractions)
+    if (!std::isfinite(k)) fail("skin[{}]: contraction of \"{}\" is not finite", ri, name);
+  if (jaw_angle && !std::isfinite(*jaw_angle)) fail("skin[{}]: jaw angle is not finite", ri);
+  resolve_skin(ri);
+  auto& r = skin_runtime().rigs[ri];
+  const JsonSource src{"set_skin_pose"};
+  const std::string path = index_path("skin", ri);
+  r.pose_override = resolve_pose(r.setup.muscles, expression, weight, contractions, jaw_angle, src,
+                                 path, m_scene.skin[ri].muscles);
+  forget_frames_of_rig(ri);
+}
+
+void Session::clear_skin_pose(std::size_t ri) {
+  if (ri >= m_scene.skin.size())
+    fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
+  resolve_skin(ri);
+  auto& r = skin_runtime().rigs[ri];
+  if (!r.pose_override) return;
+  r.pose_override.reset();
+  forget_frames_of_rig(ri);
+}
+
+void Session::skin_forget_last(std::size_t ri) {
+  auto& r = skin_runtime().rigs.at(ri);
+  r.last.reset();
+  r.last_frame = -1;
+}
+
+bool Session::skin_pose_overridden() const {
+  if (!m_skin) return false;
+  return std::any_of(m_skin->rigs.begin(), m_skin->rigs.end(),
+                     [](const SkinRuntime::Rig& r) { return r.pose_override.has_value(); });
+}
+
+std::vector<std::string> Session::skin_muscle_names(std::size_t ri) {
+  if (ri >= m_scene.skin.size())
+    fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
+  resolve_skin(ri);
+  return skin_runtime().rigs[ri].setup.muscles.muscle_names();
+}
+
+std::vector<std::string> Session::skin_expression_names(std::size_t ri) {
+  if (ri >= m_scene.skin.size())
+    fail("skin rig {} out of range ({} rigs)", ri, m_scene.skin.size());
+  resolve_skin(ri);
+  return expression_names(skin_runtime().rigs[ri].setup.muscles);
 }
 
 std::optional<std::size_t> Session::skin_rig_of_mesh(std::size_t asset) const {

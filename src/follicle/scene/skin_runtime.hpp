@@ -24,6 +24,7 @@ class SkinRuntime {
     skin::MusclePose static_pose;  // expression * weight with the explicit contractions
     std::vector<anim::ScalarTrack> muscle_tracks;  // one per muscle (empty: no track)
     anim::ScalarTrack jaw_track;
+    std::optional<skin::MusclePose> pose_override;  // Session::set_skin_pose
     std::unique_ptr<skin::FaceRig> rig;
     skin::FaceState state;
     int last_frame = -1;  // frame of `last` (-2: a still face, valid for every frame)

@@ -87,7 +87,8 @@ struct SkinKey {
   template <class V>
   void visit(V&& v) {
     v("t", t, ParamInfo{"key time", "s", 0.0, 1e6});
-    v("expression", expression, ParamInfo{"expression of the face-setup file"});
+    v("expression", expression,
+      ParamInfo{"expression of the face-setup file (\"\": none, only the contractions)"});
     v("weight", weight, ParamInfo{"expression weight (0 neutral, 1 full)", "", -2.0, 2.0});
     v("contractions", contractions,
       ParamInfo{"per-muscle contractions by name, replacing the expression's", "", -10.0, 10.0});
@@ -171,7 +172,8 @@ struct SkinSpec {
       ParamInfo{"face-setup file (muscles, expressions, wrinkles; e.g. "
                 "data/muscles/lee_perry_smith.json), relative to the scene file"});
     v("expression", expression,
-      ParamInfo{"expression of the face-setup file shown when there is no track"});
+      ParamInfo{"expression of the face-setup file shown when there is no track (\"\": none, "
+                "only the contractions)"});
     v("weight", weight, ParamInfo{"expression weight (0 neutral, 1 full)", "", -2.0, 2.0});
     v("contractions", contractions,
       ParamInfo{"per-muscle contractions by name, replacing the expression's", "", -10.0, 10.0});
