@@ -79,7 +79,8 @@ void check_text(const fs::path& path, const std::string& text) {
 // ------------------------------------------------------------------------------------- OBJ
 
 // Validation pass: finite coordinates, enough components, indices in range; with line numbers.
-void validate_obj(const fs::path& path, const std::string& text) {
+// Returns the largest number of vertices of a face.
+std::size_t validate_obj(const fs::path& path, const std::string& text) {
   check_text(path, text);
   struct Deferred {
     std::size_t line;
@@ -87,6 +88,7 @@ void validate_obj(const fs::path& path, const std::string& text) {
   };
   std::vector<Deferred> deferred;  // positive indices may (rarely) refer forward
   long long nv = 0, nvt = 0, nvn = 0, nf = 0;
+  std::size_t max_arity = 0;
   std::vector<std::string_view> toks;
   std::size_t line_no = 0, pos = 0;
   const std::string_view all(text);
@@ -125,6 +127,7 @@ void validate_obj(const fs::path& path, const std::string& text) {
       if (toks.size() < 4)
         fail_at(at_line(path, line_no), "face needs at least 3 vertices, found {}",
                 toks.size() - 1);
+      max_arity = std::max(max_arity, toks.size() - 1);
       Deferred d{line_no, 0, 0, 0};
       for (std::size_t k = 1; k < toks.size(); ++k) {
         std::string_view t = toks[k];
@@ -168,14 +171,55 @@ void validate_obj(const fs::path& path, const std::string& text) {
               nvn);
   }
   if (nf == 0) fail_at(path.string(), "no faces found ({} vertices): not a triangle mesh OBJ", nv);
+  return max_arity;
+}
+
+// tinyobjloader's ear clipping (right for concave quads and n-gons) takes time growing faster than
+// the square of a face's size (one face of 100k vertices: 8.7 s), and it cannot hold a face of
+// more than 255 vertices untriangulated. Faces above kMaxEarClippedFace vertices (scanner caps,
+// hole fills) are rewritten as triangle fans before it sees them, in linear time; relative
+// (negative) indices keep their meaning because no vertex line moves.
+constexpr std::size_t kMaxEarClippedFace = 64;
+
+std::string fan_large_faces(const std::string& text) {
+  std::string out;
+  out.reserve(text.size() + text.size() / 2);
+  std::vector<std::string_view> toks;
+  std::size_t pos = 0;
+  const std::string_view all(text);
+  while (pos < all.size()) {
+    std::size_t eol = all.find('\n', pos);
+    if (eol == std::string_view::npos) eol = all.size();
+    const std::string_view raw = all.substr(pos, eol - pos);
+    pos = eol + 1;
+    std::string_view line = raw;
+    if (auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    split_ws(line, toks);
+    if (toks.size() > kMaxEarClippedFace + 1 && toks[0] == "f") {
+      for (std::size_t k = 2; k + 1 < toks.size(); ++k) {
+        out += "f ";
+        out += toks[1];
+        out += ' ';
+        out += toks[k];
+        out += ' ';
+        out += toks[k + 1];
+        out += '\n';
+      }
+    } else {
+      out += raw;
+      out += '\n';
+    }
+  }
+  return out;
 }
 
 TriMesh load_obj(const fs::path& path) {
-  const std::string text = read_file(path);
-  validate_obj(path, text);
+  std::string text = read_file(path);
+  const std::size_t max_arity = validate_obj(path, text);
   tinyobj::ObjReaderConfig cfg;
   cfg.triangulate = true;
   cfg.vertex_color = false;
+  if (max_arity > kMaxEarClippedFace) text = fan_large_faces(text);
   tinyobj::ObjReader reader;
   if (!reader.ParseFromString(text, std::string(), cfg))
     fail_at(path.string(), "tinyobjloader failed: {}", reader.Error());
@@ -998,7 +1042,10 @@ TriMesh load_mesh(const std::filesystem::path& path, LengthUnit unit) {
   else
     fail_at(path.string(), "unknown mesh extension '{}': expected .obj, .ply, .gltf or .glb", ext);
   const double s = unit_to_metres(unit);
-  if (s != 1.0) m.scale(s);
+  if (s != 1.0) {
+    m.scale(s);
+    m.check(path.string());  // the size limits hold in metres too
+  }
   return m;
 }
 

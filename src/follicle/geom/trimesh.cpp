@@ -48,6 +48,16 @@ void TriMesh::check(const std::string& where) const {
     if (!positions[i].allFinite())
       fail_at(where, "vertex {} has a non-finite coordinate ({}, {}, {})", i, positions[i].x(),
               positions[i].y(), positions[i].z());
+  // Finite but so large that areas, normals and distances overflow (a 1e308 coordinate gave a
+  // surface area of inf): no head, hand or scene is a million kilometres across (checked in the
+  // file's units by the readers and in metres after conversion).
+  constexpr double kMaxCoordinate = 1e9;
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    if (positions[i].cwiseAbs().maxCoeff() > kMaxCoordinate)
+      fail_at(where,
+              "vertex {} has coordinate ({:g}, {:g}, {:g}), beyond +-{:g}: a corrupt file or "
+              "wrong units",
+              i, positions[i].x(), positions[i].y(), positions[i].z(), kMaxCoordinate);
   for (std::size_t f = 0; f < faces.size(); ++f)
     for (int k = 0; k < 3; ++k)
       if (faces[f][k] < 0 || faces[f][k] >= nv)

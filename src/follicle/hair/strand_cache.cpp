@@ -94,6 +94,8 @@ StrandFrame parse_strand_frame(const std::string& b, const std::string& where) {
   for (std::size_t i = 1; i < s.offsets.size(); ++i)
     if (s.offsets[i] < s.offsets[i - 1])
       fail_at(where, "strand cache offsets decrease at strand {}", i - 1);
+  // A NaN or infinite coordinate would surface later, far from the file that holds it.
+  s.check(where);
   return f;
 }
 

@@ -205,6 +205,11 @@ void Session::build_hair_group(std::size_t gi) {
     if (std::string_view(e.what()).starts_with(m_source + ": hair[")) throw;
     fail("{}: {}", w, e.what());
   }
+  if (groom->num_strands() == 0)
+    m_ctx->log().warn(
+        "{}: no strands grew: the head is bald (check the style's density and density_scale, "
+        "the scalp region and the hull's size against mesh \"{}\")",
+        w, hs.mesh);
   // A mesh with a skin rig deforms: the roots ride its refined surface (ride_skin).
   if (const auto ri = skin_rig_of_mesh(mi)) {
     geom::TriMesh refined = face_rig(*ri).rest_mesh();

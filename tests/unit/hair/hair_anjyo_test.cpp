@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -208,6 +209,22 @@ TEST(StrandCache, RoundTripAndBadInput) {
   std::string wrong = bytes;
   wrong[8] = 9;  // version
   EXPECT_THROW(parse_strand_frame(wrong, "x"), Error);
+}
+
+TEST(StrandCache, ANonFiniteCoordinateIsRefusedNamingTheCacheFile) {
+  StrandFrame f;
+  f.frame = 3;
+  f.strands.points = {Vec3f(0, 0, 0), Vec3f(0, std::nanf(""), 0.1f)};
+  f.strands.offsets = {0, 2};
+  const auto dir = test::scratch_dir("strand_cache_nan");
+  write_strand_frame(dir, f);  // the writer does not judge (a blown-up state is stopped earlier)
+  try {
+    (void)read_strand_frame(dir, 3);
+    FAIL() << "a NaN coordinate was accepted";
+  } catch (const Error& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("strands_000003.fsc"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("strand point 1 is not finite"));
+  }
 }
 
 // Preview: set FOLLICLE_HAIR_PREVIEW=/tmp/dir to render the four presets on the default head with
