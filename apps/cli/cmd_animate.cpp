@@ -95,9 +95,8 @@ int run_animate(const GlobalOptions& g, const AnimateArgs& a) {
   }
   if (!a.cache.empty()) session.set_strand_cache(a.cache);
   const std::filesystem::path dir(a.output_dir);
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) fail_at(dir.string(), "cannot create the output folder: {}", ec.message());
+  check_output_folder(dir);  // before the work, not after
+  if (!a.no_video) check_output_writable(mp4);
 
   auto renderer = render::Renderer::create_headless(*ctx);
   ctx->log().info("renderer: {}", renderer->device_description());

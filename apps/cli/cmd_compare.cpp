@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "commands.hpp"
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/units.hpp"
 #include "follicle/geom/mesh_distance.hpp"
@@ -83,6 +84,7 @@ int run_compare(const GlobalOptions& g, const CompareArgs& a) {
   const double scale = 1.0 / unit_to_metres(unit);
 
   // Everything that can fail happens before the PNG is written (atomically).
+  if (!a.output.empty()) check_output_writable(a.output);
   std::optional<image::ImageRGBA8> img;
   double vmax = 0;
   if (!a.output.empty()) {

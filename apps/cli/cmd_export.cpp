@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/units.hpp"
 #include "follicle/geom/strand_io.hpp"
 #include "follicle/scene/session.hpp"
@@ -43,6 +44,7 @@ int run_export(const GlobalOptions& g, const ExportArgs& a) {
     throw UsageError(fmt::format("--frame {} is past the scene's last frame {}", a.frame,
                                  session.frame_count() - 1));
   if (!a.cache.empty()) session.set_strand_cache(a.cache);
+  check_output_writable(a.hair);  // before the simulation, not after
   const geom::StrandSet hair = session.all_hair(a.frame);
   geom::save_strands(hair, a.hair, unit);  // atomic (temp file + rename)
   if (!g.quiet)

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/progress.hpp"
 #include "follicle/scene/session.hpp"
@@ -33,9 +34,7 @@ int run_export_maps(const GlobalOptions& g, const ExportArgs& a) {
     throw UsageError(
         fmt::format("--frames {}-{}: the scene has frames 0-{}", first, last, count - 1));
   const std::filesystem::path dir(a.maps);
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) fail_at(dir.string(), "cannot create the maps folder: {}", ec.message());
+  check_output_folder(dir);
   Progress progress("maps", std::size_t(last - first + 2), !g.quiet);
   session.export_wrinkle_maps(dir, -1);  // rest state
   progress.tick();

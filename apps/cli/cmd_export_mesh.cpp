@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/units.hpp"
 #include "follicle/geom/mesh_io.hpp"
@@ -26,6 +27,7 @@ int run_export_mesh(const GlobalOptions& g, const ExportArgs& a) {
 
   auto ctx = make_context(g);
   auto session = scene::Session::load(a.scene, *ctx);
+  check_output_writable(a.mesh);  // before the face rig is built, not after
   const auto& skin = session.scene().skin;
   if (skin.empty())
     fail_at(a.scene, "the scene has no \"skin\" face rigs; --mesh exports a deformed face");

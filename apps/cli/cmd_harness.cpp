@@ -98,6 +98,8 @@ int run_harness(const GlobalOptions& g, const HarnessArgs& a) {
             "a still scene (no \"animation\" section): the harness compares hair models over "
             "time; add an animation (fps, frames or duration, head_motion, wind)");
   if (sc.hair.empty()) fail_at(a.scene, "the scene has no hair groups (\"hair\": [...])");
+  check_output_writable(a.json);  // before the simulations, not after
+  check_output_writable(a.sheet);
   // --group: an index into hair[] or a group's name.
   if (!a.group.empty()) {
     bool found = false;

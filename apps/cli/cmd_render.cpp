@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "commands.hpp"
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/log.hpp"
 #include "follicle/core/progress.hpp"
 #include "follicle/image/image_io.hpp"
@@ -44,6 +45,7 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
   }
   if (outputs.empty())
     throw UsageError(fmt::format("{} lists no outputs: give -o FILE.png", a.scene));
+  for (const auto& out : outputs) check_output_writable(out);  // before the work, not after
 
   Progress progress("render", 2 + outputs.size(), !g.quiet);
   const auto rs = session.render_scene(a.frame);

@@ -42,6 +42,46 @@ void write_atomically(const std::filesystem::path& path,
   }
 }
 
+namespace {
+
+// Creates and removes `probe`; throws naming `what` with the system's reason.
+void probe_write(const std::filesystem::path& probe, const std::string& what) {
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int err = errno;
+    if (err == EEXIST) return;  // a leftover temporary of ours: the folder takes files
+    fail_at(what, "cannot write here: {}", std::strerror(err));
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+}  // namespace
+
+void check_output_writable(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) fail_at(path.string(), "is a folder, expected a file name");
+  if (path.has_parent_path()) {
+    fs::create_directories(path.parent_path(), ec);
+    if (ec)
+      fail_at(path.string(), "cannot create directory {}: {}", path.parent_path().string(),
+              ec.message());
+  }
+  fs::path tmp = path;
+  tmp += ".tmp-" + std::to_string(::getpid());
+  probe_write(tmp, path.string());
+}
+
+void check_output_folder(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) fail_at(dir.string(), "cannot create the output folder: {}", ec.message());
+  if (!fs::is_directory(dir, ec)) fail_at(dir.string(), "is not a folder");
+  probe_write(dir / (".follicle-probe-" + std::to_string(::getpid())), dir.string());
+}
+
 void write_file_atomically(const std::filesystem::path& path, const std::string& bytes) {
   // POSIX calls rather than std::ofstream: every write, the flush to the disk and the close are
   // checked and their errno reported (a stream on a full disk may fail only at close, and says
