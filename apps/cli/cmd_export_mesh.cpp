@@ -24,6 +24,9 @@ int run_export_mesh(const GlobalOptions& g, const ExportArgs& a) {
     throw UsageError(fmt::format("--mesh must end in .obj, .ply, .gltf or .glb, got '{}'", a.mesh));
   if (a.frame < 0) throw UsageError(fmt::format("--frame must be >= 0, got {}", a.frame));
   const LengthUnit unit = parse_length_unit(a.units);
+  if ((ext == ".gltf" || ext == ".glb") && unit != LengthUnit::m)
+    throw UsageError(fmt::format(
+        "--mesh {}: glTF stores metres by specification; use --units m (not {})", a.mesh, a.units));
 
   auto ctx = make_context(g);
   auto session = scene::Session::load(a.scene, *ctx);

@@ -31,10 +31,17 @@ def test_units_scale_exactly_to_metres(root):
 def test_mesh_round_trip_through_every_writer(root, tmp_path, ext):
     m = follicle.load_mesh(root / TORUS, units="m")
     out = tmp_path / ("torus" + ext)
-    m.save(out, units="mm")
-    back = follicle.load_mesh(out, units="mm")
+    units = "m" if ext == ".glb" else "mm"  # glTF is metres by specification
+    m.save(out, units=units)
+    back = follicle.load_mesh(out, units=units)
     assert back.num_faces == m.num_faces
     np.testing.assert_allclose(back.bounds, m.bounds, atol=1e-6)
+
+
+def test_gltf_in_other_units_is_refused(root, tmp_path):
+    m = follicle.load_mesh(root / TORUS, units="m")
+    with pytest.raises(follicle.Error, match="glTF stores metres by specification"):
+        m.save(tmp_path / "torus.glb", units="mm")
 
 
 def test_mesh_from_arrays_computes_outward_normals():

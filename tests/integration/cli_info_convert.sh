@@ -17,10 +17,15 @@ grep -q '^bounds max: \[' "$TMP/info0" || fail "no bounds"
 grep -q '^meshes: 1' "$TMP/sinfo" || fail "scene info: meshes"
 grep -q '^lights: 3' "$TMP/sinfo" || fail "scene info: lights"
 
-# mm OBJ -> m PLY (binary) -> cm glTF -> mm OBJ; and an ASCII PLY.
+# mm OBJ -> m PLY (binary) -> glTF (metres by specification) -> mm OBJ; and an ASCII PLY.
 "$FOLLICLE" convert "$MESH" "$TMP/a.ply" --in-units mm --out-units m -q || fail "convert obj->ply"
-"$FOLLICLE" convert "$TMP/a.ply" "$TMP/b.gltf" --in-units m --out-units cm -q || fail "convert ply->gltf"
-"$FOLLICLE" convert "$TMP/b.gltf" "$TMP/c.obj" --in-units cm --out-units mm -q || fail "convert gltf->obj"
+if "$FOLLICLE" convert "$TMP/a.ply" "$TMP/bad.gltf" --in-units m --out-units cm -q 2>"$TMP/err"; then
+  fail "a glTF in cm was written"
+fi
+grep -q "glTF stores metres by specification" "$TMP/err" || fail "glTF unit message: $(cat "$TMP/err")"
+[ ! -e "$TMP/bad.gltf" ] || fail "a refused glTF was left behind"
+"$FOLLICLE" convert "$TMP/a.ply" "$TMP/b.gltf" --in-units m --out-units m -q || fail "convert ply->gltf"
+"$FOLLICLE" convert "$TMP/b.gltf" "$TMP/c.obj" --in-units m --out-units mm -q || fail "convert gltf->obj"
 "$FOLLICLE" convert "$MESH" "$TMP/d.ply" --in-units mm --out-units mm --ascii -q || fail "convert ascii ply"
 head -c 3 "$TMP/d.ply" | grep -q ply || fail "ascii ply header"
 grep -q 'format ascii' "$TMP/d.ply" || fail "ply is not ascii"

@@ -234,6 +234,12 @@ TriMesh load_obj(const fs::path& path) {
   for (std::size_t i = 0; i < m.uvs.size(); ++i)
     m.uvs[i] = Vec2(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
   bool any_missing_uv = false;
+  // `vn` normals are per corner; TriMesh keeps one per position vertex: the normalised sum of
+  // the normals its corners use (the file's normal where a vertex has one, a smooth blend across
+  // a hard edge). Kept only when every corner names a normal.
+  const std::size_t nn = attrib.normals.size() / 3;
+  std::vector<Vec3> normal_sum(nn > 0 ? m.positions.size() : 0, Vec3::Zero());
+  bool all_normals = nn > 0;
   for (const auto& shape : reader.GetShapes()) {
     const auto& mesh = shape.mesh;
     std::size_t base = 0;
@@ -245,6 +251,16 @@ TriMesh load_obj(const fs::path& path) {
         m.faces.emplace_back(c[0].vertex_index, c[1].vertex_index, c[2].vertex_index);
         m.uv_faces.emplace_back(c[0].texcoord_index, c[1].texcoord_index, c[2].texcoord_index);
         for (const auto& ci : c) any_missing_uv |= ci.texcoord_index < 0;
+        for (const auto& ci : c) {
+          if (!all_normals) break;
+          if (ci.normal_index < 0 || std::size_t(ci.normal_index) >= nn || ci.vertex_index < 0 ||
+              std::size_t(ci.vertex_index) >= normal_sum.size()) {
+            all_normals = false;
+            break;
+          }
+          const auto* q = &attrib.normals[3 * std::size_t(ci.normal_index)];
+          normal_sum[std::size_t(ci.vertex_index)] += Vec3(q[0], q[1], q[2]);
+        }
       }
       base += n;
     }
@@ -259,6 +275,28 @@ TriMesh load_obj(const fs::path& path) {
         if (f[k] < 0) f[k] = dummy;
   }
   if (m.faces.empty()) fail_at(path.string(), "no faces after triangulation");
+  if (all_normals) {
+    m.normals.resize(m.positions.size(), Vec3::Zero());
+    for (std::size_t i = 0; i < m.positions.size(); ++i) {
+      const double len = normal_sum[i].norm();
+      if (len > 0 && std::isfinite(len)) {
+        m.normals[i] = normal_sum[i] / len;
+      } else if (len == 0 && normal_sum[i].allFinite()) {
+        continue;  // unused vertex or opposite normals: filled in below
+      } else {
+        all_normals = false;
+        break;
+      }
+    }
+    if (!all_normals) {
+      m.normals.clear();
+    } else {  // vertices without a usable file normal get the computed one
+      const std::vector<Vec3> file = m.normals;
+      m.compute_normals();
+      for (std::size_t i = 0; i < file.size(); ++i)
+        if (file[i] != Vec3::Zero()) m.normals[i] = file[i];
+    }
+  }
   m.check(path.string());
   return m;
 }
@@ -1054,6 +1092,11 @@ void save_mesh(const TriMesh& mesh, const std::filesystem::path& path, LengthUni
   const std::string ext = lower_ext(path);
   if (ext != ".obj" && ext != ".ply" && ext != ".gltf" && ext != ".glb")
     fail_at(path.string(), "unknown mesh extension '{}': expected .obj, .ply, .gltf or .glb", ext);
+  // glTF 2.0 fixes the unit: "the units for all linear distances are meters". A file in mm would
+  // be read by every other tool as 1000 times too large (a 400 m head in Blender).
+  if ((ext == ".gltf" || ext == ".glb") && unit != LengthUnit::m)
+    fail_at(path.string(), "glTF stores metres by specification; write it with units m, not {}",
+            to_string(unit));
   mesh.check(path.string());
   TriMesh m = mesh;
   const double s = unit_to_metres(unit);

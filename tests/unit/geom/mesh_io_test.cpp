@@ -72,6 +72,28 @@ TEST(MeshIO, ObjRoundTripKeepsSeparateUvIndices) {
   expect_same_surface(cube, back, 1e-12);
 }
 
+TEST(MeshIO, ObjVertexNormalsAreReadAndSurviveConversion) {
+  // Before: `vn` lines were ignored, so an OBJ's normals were lost and a glTF converted from it
+  // had none (flat shading in glTF readers: Blender split the Sintel bust into 3 x its faces).
+  const auto dir = test::scratch_dir("obj-normals");
+  write_text(dir / "n.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+             "vn 0 0.6 0.8\nvn 0 0 1\n"
+             "f 1//1 2//1 3//1\nf 2//2 4//2 3//2\n");
+  const TriMesh m = load_mesh(dir / "n.obj", LengthUnit::m);
+  ASSERT_TRUE(m.has_normals());
+  EXPECT_TRUE(m.normals[0].isApprox(Vec3(0, 0.6, 0.8)));  // one corner: the file's normal
+  EXPECT_TRUE(m.normals[3].isApprox(Vec3(0, 0, 1)));
+  EXPECT_TRUE(m.normals[1].isApprox(Vec3(0, 0.6, 1.8).normalized()));  // two: their blend
+  save_mesh(m, dir / "n.glb", LengthUnit::m);
+  const TriMesh g = load_mesh(dir / "n.glb", LengthUnit::m);
+  ASSERT_TRUE(g.has_normals());
+  EXPECT_EQ(g.num_vertices(), m.num_vertices());
+  // A file whose faces name normals only in part keeps none (computed later by the user).
+  write_text(dir / "part.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3\n");
+  EXPECT_FALSE(load_mesh(dir / "part.obj", LengthUnit::m).has_normals());
+}
+
 TEST(MeshIO, UnitsConvertOnLoadAndSave) {
   const auto dir = test::scratch_dir("units");
   const TriMesh cube = make_cube();  // 1 m cube
@@ -156,10 +178,22 @@ TEST(MeshIO, ConvertBetweenAllFormatsKeepsGeometry) {
   TriMesh m = make_cube();
   const char* chain[] = {"a.obj", "b.ply", "c.glb", "d.gltf", "e.obj"};
   for (const char* name : chain) {
-    save_mesh(m, dir / name, LengthUnit::mm);
-    m = load_mesh(dir / name, LengthUnit::mm);
+    // OBJ and PLY in mm; glTF in metres, as its specification fixes.
+    const bool gltf =
+        std::string_view(name).ends_with("gltf") || std::string_view(name).ends_with("glb");
+    const LengthUnit u = gltf ? LengthUnit::m : LengthUnit::mm;
+    save_mesh(m, dir / name, u);
+    m = load_mesh(dir / name, u);
   }
   expect_same_surface(make_cube(), m, 1e-6);
+  try {
+    save_mesh(m, dir / "mm.glb", LengthUnit::mm);
+    FAIL() << "a glTF in mm was written";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("glTF stores metres by specification"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "mm.glb"));
 }
 
 TEST(MeshIO, DefaultHeadLoads) {
