@@ -13,25 +13,42 @@ function(follicle_target_settings tgt)
   endif()
 endfunction()
 
+include(GNUInstallDirs)
+
 # follicle_module(name DEPS <targets...>): a static library from every .cpp in the folder.
 # Headers live beside sources and are included as <follicle/<name>/x.hpp>.
+# Each module is installed (library + its .hpp) into the export set FollicleTargets as
+# Follicle::<name>; cmake/install.cmake writes the package (see docs/install.md).
 function(follicle_module name)
   cmake_parse_arguments(ARG "" "" "DEPS;PRIVATE_DEPS" ${ARGN})
   file(GLOB srcs CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  file(GLOB hdrs CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.hpp)
+  set(tgt follicle_${name})
+  set(includes $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src>
+               $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   if(NOT srcs)
     # Header-only so far.
-    add_library(follicle_${name} INTERFACE)
-    add_library(follicle::${name} ALIAS follicle_${name})
-    target_include_directories(follicle_${name} INTERFACE ${PROJECT_SOURCE_DIR}/src)
-    target_link_libraries(follicle_${name} INTERFACE ${ARG_DEPS})
-    return()
+    add_library(${tgt} INTERFACE)
+    target_include_directories(${tgt} INTERFACE ${includes})
+    target_link_libraries(${tgt} INTERFACE ${ARG_DEPS})
+    target_compile_features(${tgt} INTERFACE cxx_std_20)
+  else()
+    add_library(${tgt} STATIC ${srcs})
+    target_include_directories(${tgt} PUBLIC ${includes})
+    # A static library's private dependencies still reach its consumers' link line
+    # ($<LINK_ONLY:...>), so FollicleConfig.cmake finds every one of them (find_dependency).
+    target_link_libraries(${tgt} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+    target_compile_features(${tgt} PUBLIC cxx_std_20)  # the headers need it; consumers get it too
+    set_target_properties(${tgt} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    follicle_target_settings(${tgt})
   endif()
-  add_library(follicle_${name} STATIC ${srcs})
-  add_library(follicle::${name} ALIAS follicle_${name})
-  target_include_directories(follicle_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
-  target_link_libraries(follicle_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
-  set_target_properties(follicle_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
-  follicle_target_settings(follicle_${name})
+  add_library(follicle::${name} ALIAS ${tgt})
+  set_target_properties(${tgt} PROPERTIES EXPORT_NAME ${name})
+  set_property(GLOBAL APPEND PROPERTY FOLLICLE_MODULES ${tgt})
+  install(TARGETS ${tgt} EXPORT FollicleTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT Follicle_Development)
+  install(FILES ${hdrs} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/follicle/${name}
+          COMPONENT Follicle_Development)
 endfunction()
 
 # follicle_test(name LIBS <targets...>): one GoogleTest program from tests/unit/<name>/*.cpp and
