@@ -21,40 +21,8 @@ fail() { echo "FAIL $*"; fails=$((fails + 1)); }
 SCENE="$ROOT/data/scenes/default.json"
 XVFB=(xvfb-run -a -s "-screen 0 1280x1024x24")
 
-# Prints "W H distinct_colours" of a PNG (stdlib only: zlib + PNG filter decoding).
-png_stats() {
-  python3 - "$1" <<'PY'
-import struct, sys, zlib
-d = open(sys.argv[1], "rb").read()
-assert d[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
-pos, idat, hdr = 8, b"", None
-while pos < len(d):
-    n, t = struct.unpack(">I4s", d[pos:pos + 8])
-    body = d[pos + 8:pos + 8 + n]
-    if t == b"IHDR": hdr = struct.unpack(">IIBBBBB", body)
-    if t == b"IDAT": idat += body
-    pos += 12 + n
-w, h, depth, ctype = hdr[:4]
-bpp = {0: 1, 2: 3, 4: 2, 6: 4}[ctype]
-raw, stride = zlib.decompress(idat), w * bpp
-prev, colours, i = bytearray(stride), set(), 0
-for y in range(h):
-    f, line = raw[i], bytearray(raw[i + 1:i + 1 + stride]); i += 1 + stride
-    for x in range(stride):
-        a = line[x - bpp] if x >= bpp else 0
-        b, c = prev[x], (prev[x - bpp] if x >= bpp else 0)
-        if f == 1: line[x] = (line[x] + a) & 255
-        elif f == 2: line[x] = (line[x] + b) & 255
-        elif f == 3: line[x] = (line[x] + (a + b) // 2) & 255
-        elif f == 4:
-            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-            line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-    if y % 4 == 0:
-        for x in range(0, stride, bpp * 4): colours.add(bytes(line[x:x + bpp]))
-    prev = line
-print(w, h, len(colours))
-PY
-}
+# Prints "W H distinct_colours" of a PNG.
+png_stats() { python3 "$(dirname "$0")/lib/png_tools.py" stats "$1"; }
 
 # 1. The 3D view.
 "${XVFB[@]}" "$VIEWER" "$SCENE" --screenshot "$TMP/view.png" --frames 3 --width 1000 --height 700 \

@@ -108,7 +108,9 @@ struct LcpParams {
     v("colinear_eps", colinear_eps, ParamInfo{"near-colinear threshold", "", 0, 1});
     v("body_collision", body_collision, ParamInfo{"hair-body collision"});
     v("contact", contact);
-    v("max_speed", max_speed, ParamInfo{"blow-up speed", "m/s", 1e-3, 1e9});
+    v("max_speed", max_speed,
+      ParamInfo{"blow-up speed (the lcp section raises it to twice wind + shake swing + free fall)",
+                "m/s", 1e-3, 1e9});
     v("neighbour_skin", neighbour_skin,
       ParamInfo{"Verlet skin / 2h of the neighbour lists", "", 0, 2});
   }

@@ -129,6 +129,9 @@ class LcpScenario {
 
   double time() const { return m_state.time; }
   const LcpSolver& solver() const { return *m_solver; }
+  /// The hair's blow-up speed [m/s]: twice the fastest legitimate motion (wind + the shake's
+  /// swing at the hair tips + a free fall over the hair length), at least LcpParams::max_speed.
+  double max_speed() const { return m_max_speed; }
   /// LcpSolver::use_simd (same results either way; for A/B benchmarks).
   void use_simd(bool on) { m_solver->use_simd(on); }
   const LcpState& state() const { return m_state; }  // head frame
@@ -146,6 +149,7 @@ class LcpScenario {
 
  private:
   LcpScenarioParams m_p;
+  double m_max_speed = 0;
   void settle(const Context& ctx, const LcpParams& lcp);
   geom::TriMesh m_head, m_torso;
   bool m_mesh_head = false;

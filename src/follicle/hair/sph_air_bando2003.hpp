@@ -50,7 +50,9 @@ struct SphAirParams {
     v("coupling_radius", coupling_radius, ParamInfo{"air-hair interaction radius", "m", 1e-5, 10});
     v("cfl", cfl, ParamInfo{"sub-step factor", "", 1e-3, 1});
     v("max_particles", max_particles, ParamInfo{"air particle cap", "", 1, 1e8});
-    v("max_speed", max_speed, ParamInfo{"blow-up speed", "m/s", 1e-3, 1e9});
+    v("max_speed", max_speed,
+      ParamInfo{"blow-up speed (the lcp section raises it to twice the wind speed)", "m/s", 1e-3,
+                1e9});
   }
   void validate() const;
 };

@@ -298,6 +298,12 @@ class GlRenderer final : public Renderer {
     glBindBuffer(GL_ARRAY_BUFFER, m_quad_vbo);
     glBufferData(GL_ARRAY_BUFFER, sizeof(quad), quad, GL_STATIC_DRAW);
     glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, m_line_width_range);
+    // A forward-compatible core context (the viewer's GLFW window) refuses glLineWidth > 1 with
+    // GL_INVALID_VALUE whatever the range reports (GL 3.3 core, appendix E.2.1), which stopped
+    // the viewer on every Anjyo scene: there, strands wider than a pixel are drawn as ribbons.
+    GLint flags = 0;
+    glGetIntegerv(GL_CONTEXT_FLAGS, &flags);
+    if (flags & GL_CONTEXT_FLAG_FORWARD_COMPATIBLE_BIT) m_line_width_range[1] = 1.0f;
     check_gl("initialisation");
     m_log->debug("render: {}", device_description());
   }

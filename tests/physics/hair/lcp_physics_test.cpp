@@ -283,6 +283,41 @@ TEST(LcpPhysics, WindPushesHairAndHairSlowsWind) {
   EXPECT_LT(v_hair, 0.97 * v_free);  // the hair slows the wind
 }
 
+TEST(LcpPhysics, TheBlowUpLimitFollowsThePhysicsAndTheTopOfTheWindRangeRuns) {
+  // Before: a 40 m/s wind stopped at frame 1 on the fixed 30 m/s hair limit ("particle has speed
+  // 30.02 m/s"), and 100 m/s (the top of wind_speed's range) tripped the air's own 100 m/s limit
+  // by 5e-6 m/s. The limits now follow the scenario: twice the wind + the shake's swing + a free
+  // fall over the hair length, and twice the wind for the air.
+  Context ctx(2);
+  LcpScenarioParams sp;
+  sp.spacing = 0.02;
+  sp.hair_length = 0.15;
+  const LcpScenario calm(ctx, sp);
+  EXPECT_EQ(calm.max_speed(), LcpParams{}.max_speed);  // 2 sqrt(2 g L) = 3.4 m/s < 30 m/s
+  sp.shake = true;
+  sp.shake_angle = 0.7;
+  sp.shake_period = 0.5;
+  LcpParams low;
+  low.max_speed = 1e-3;  // the physical bound shows through
+  const LcpScenario shaking(ctx, sp, low);
+  EXPECT_NEAR(shaking.max_speed(),
+              2 * (0.7 * 2 * M_PI / 0.5 * (0.1 + 0.15) + std::sqrt(2 * 9.81 * 0.15)), 0.05);
+  sp.shake = false;
+  sp.wind = true;
+  sp.air_spacing = 0.03;
+  for (const double w : {40.0, 100.0}) {
+    sp.wind_speed = w;
+    LcpScenario s(ctx, sp);
+    EXPECT_GE(s.max_speed(), 2 * w);
+    EXPECT_GE(s.air()->params().max_speed, 2 * w);
+    for (int k = 0; k < 6; ++k) {
+      const auto rep = s.step(ctx, 1.0 / 60);
+      ASSERT_TRUE(rep.ok) << w << " m/s, frame " << k << ": " << rep.message;
+    }
+    for (const Vec3& x : s.state().x) ASSERT_TRUE(x.allFinite());
+  }
+}
+
 TEST(LcpPhysics, AirAtItsOwnStableStepMovesTheHairAsTheTightCoupling) {
   // Multi-rate coupling (as `follicle bench lcp-wind` and, coarser, the scenes run it): the SPH
   // air advances at its own stable step (SphAir::stable_step, k hair sub-steps), its mean drag
