@@ -10,7 +10,10 @@
 #include <stb_image.h>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <cctype>
+#include <cstdint>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <string>
@@ -24,11 +27,46 @@ struct StbFree {
   void operator()(unsigned char* p) const { stbi_image_free(p); }
 };
 
+// stb_image (Debian's 2022 snapshot) writes past its Huffman size table when a JPEG's DHT
+// segment declares more than 256 codes (found by fuzz/fuzz_png, reproducer in
+// fuzz/regressions/png/). Walks the JPEG markers up to the scan and refuses such tables first.
+void check_jpeg_huffman_tables(const std::string& b, const std::string& where) {
+  if (b.size() < 4 || uint8_t(b[0]) != 0xFF || uint8_t(b[1]) != 0xD8) return;  // not a JPEG
+  std::size_t pos = 2;
+  while (pos + 4 <= b.size()) {
+    if (uint8_t(b[pos]) != 0xFF) return;  // stb reports the corruption itself
+    const uint8_t marker = uint8_t(b[pos + 1]);
+    if (marker == 0xFF) {  // fill byte
+      ++pos;
+      continue;
+    }
+    if (marker == 0xD8 || (marker >= 0xD0 && marker <= 0xD7) || marker == 0x01) {
+      pos += 2;
+      continue;
+    }
+    if (marker == 0xDA || marker == 0xD9) return;  // start of scan / end of image
+    const std::size_t len = (std::size_t(uint8_t(b[pos + 2])) << 8) | uint8_t(b[pos + 3]);
+    const std::size_t end = std::min(b.size(), pos + 2 + len);
+    if (marker == 0xC4) {  // DHT: tables of (class/id, 16 counts, symbols)
+      std::size_t q = pos + 4;
+      while (q + 17 <= end) {
+        std::size_t codes = 0;
+        for (int k = 1; k <= 16; ++k) codes += uint8_t(b[q + std::size_t(k)]);
+        if (codes > 256)
+          fail_at(where, "corrupt JPEG: a Huffman table declares {} codes (at most 256)", codes);
+        q += 17 + codes;
+      }
+    }
+    pos += 2 + len;
+  }
+}
+
 template <int C>
 Image<uint8_t, C> read_stb(const std::filesystem::path& path) {
   const std::string bytes = read_file(path);
   if (bytes.empty()) fail_at(path.string(), "empty file, expected a PNG or JPEG image");
   if (bytes.size() > std::size_t(INT32_MAX)) fail_at(path.string(), "file too large");
+  check_jpeg_huffman_tables(bytes, path.string());
   int w = 0, h = 0, n = 0;
   std::unique_ptr<unsigned char, StbFree> px(stbi_load_from_memory(
       reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w, &h, &n, C));
@@ -81,6 +119,33 @@ void write_exr_impl(const std::filesystem::path& path, const Image<float, C>& im
   });
 }
 
+// OpenEXR 3.1 allocates whatever size a header attribute declares before it notices the file
+// is shorter (a 44-byte file took 10-33 s; found by fuzz/fuzz_exr, reproducers in
+// fuzz/regressions/exr/). The attribute list is walked first: every declared size must fit in
+// the file.
+void check_exr_header(const std::string& b, const std::string& where) {
+  if (b.size() < 8 || b.compare(0, 4, "\x76\x2f\x31\x01") != 0)
+    fail_at(where, "not an OpenEXR file (bad magic number)");
+  if (uint8_t(b[5]) & 0x10) return;  // multi-part: several headers; OpenEXR checks those itself
+  std::size_t pos = 8;
+  for (int attr = 0;; ++attr) {
+    const std::size_t name_end = b.find('\0', pos);
+    if (name_end == std::string::npos) fail_at(where, "truncated EXR header");
+    if (name_end == pos) return;  // the empty name ends the header
+    const std::string name = b.substr(pos, std::min<std::size_t>(name_end - pos, 64));
+    const std::size_t type_end = b.find('\0', name_end + 1);
+    if (type_end == std::string::npos || type_end + 5 > b.size())
+      fail_at(where, "truncated EXR header (attribute {})", attr);
+    int32_t size = 0;
+    std::memcpy(&size, b.data() + type_end + 1, 4);  // little-endian, as the format
+    pos = type_end + 5;
+    if (size < 0 || std::size_t(size) > b.size() - pos)
+      fail_at(where, "EXR header attribute \"{}\" declares {} bytes but the file has {} left", name,
+              size, b.size() - pos);
+    pos += std::size_t(size);
+  }
+}
+
 /// Reads the named channels (first match of each alternative list) into a float image;
 /// channels that are absent are filled with `fill[c]`.
 template <int C>
@@ -88,6 +153,7 @@ Image<float, C> read_exr_impl(const std::filesystem::path& path,
                               const std::vector<std::vector<std::string>>& wanted,
                               const float* fill) {
   if (!std::filesystem::exists(path)) fail_at(path.string(), "cannot open: no such file");
+  check_exr_header(read_file(path), path.string());
   try {
     Imf::InputFile file(path.string().c_str());
     const Imath::Box2i dw = file.header().dataWindow();

@@ -174,6 +174,8 @@ class Session {
   std::unique_ptr<HairRuntime> m_hair;
   HairRuntime& hair_runtime();
   void build_hair_group(std::size_t group);
+  void check_head_size(std::size_t mesh, const geom::TriMesh& world,
+                       const std::string& where) const;
   void ride_skin(std::size_t group, int frame, geom::StrandSet& strands);
   std::shared_ptr<HandRuntime> m_hand;  // shared_ptr: incomplete type here
   std::shared_ptr<LcpRuntime> m_lcp;

@@ -149,6 +149,30 @@ std::size_t Session::groom_index(const std::string& name) const {
   fail_at(m_source, "no groom asset named \"{}\"", name);
 }
 
+void Session::check_head_size(std::size_t mi, const geom::TriMesh& world,
+                              const std::string& where) const {
+  // A head is 0.2-0.3 m across, a bust up to 0.6 m. A mesh declared in the wrong units grows hair
+  // for minutes and gigabytes (a cm head read as metres: 6.9 M strands, 11 GB, then a GL error), so
+  // an implausible size is named with the unit that would make it a head: a warning up to 10 m and
+  // 1 cm, an error beyond.
+  const auto& a = m_scene.assets.meshes[mi];
+  const double diag = world.bounds().diagonal().norm();
+  if (!std::isfinite(diag) || diag < 0.05 || diag > 2.0) {
+    std::string hint;
+    for (const LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::dm, LengthUnit::m}) {
+      const double d = diag / unit_to_metres(a.units) * unit_to_metres(u);
+      if (u != a.units && d >= 0.1 && d <= 1.0)
+        hint = fmt::format("; with \"units\": \"{}\" it would be {:.2f} m", to_string(u), d);
+    }
+    const std::string msg = fmt::format(
+        "mesh \"{}\" is {:.3g} m across (assets.meshes[{}].units is \"{}\"); a head or bust is "
+        "0.2-0.6 m (a wrong unit grows hair for minutes and gigabytes){}",
+        a.name, diag, mi, to_string(a.units), hint);
+    if (!(diag <= 10.0) || diag < 0.01) fail("{}: {}", where, msg);
+    m_ctx->log().warn("{}: {}", where, msg);
+  }
+}
+
 void Session::build_hair_group(std::size_t gi) {
   auto& rt = hair_runtime();
   auto& g = rt.groups[gi];
@@ -158,6 +182,7 @@ void Session::build_hair_group(std::size_t gi) {
   const std::size_t mi = mesh_index(hs.mesh);
   geom::TriMesh world = *mesh(mi);
   world.transform(m_scene.assets.meshes[mi].transform.matrix());
+  check_head_size(mi, world, w);
   auto groom = std::make_shared<hair::Groom>();
   try {
     g.hull = hair_hull(gi);

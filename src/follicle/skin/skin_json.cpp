@@ -134,6 +134,8 @@ Json parse(const std::string& text, const std::string& file) {
     return Json::parse(text);
   } catch (const Json::parse_error& e) {
     throw Error(file.empty() ? "json" : file, std::string("JSON syntax error: ") + e.what());
+  } catch (const Json::exception& e) {  // e.g. out_of_range 406: 1e9999 overflows a double
+    throw Error(file.empty() ? "json" : file, std::string("invalid JSON: ") + e.what());
   }
 }
 

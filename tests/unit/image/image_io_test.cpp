@@ -192,3 +192,32 @@ TEST(ImageIO, AWriteThatRunsOutOfSpaceFailsNamingThePathAndLeavesNoFile) {
   write_png(file, img);
   EXPECT_EQ(read_png_rgba(file).storage(), img.storage());
 }
+
+// Reproducers of the fuzzing campaign (fuzz/regressions/, docs/reliability.md): each is refused
+// with follicle::Error naming the file, before the library that misbehaved sees it.
+TEST(ImageIOFuzzRegressions, AJpegHuffmanTableWithTooManyCodesIsRefusedBeforeStb) {
+  // Before: stb_image wrote past its Huffman size table (ASan: heap-buffer-overflow).
+  const auto f = test::source_dir() / "fuzz/regressions/png/stb_jpeg_huffman_count_overflow.jpg";
+  try {
+    (void)read_png_rgba(f);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("a Huffman table declares"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find(f.string()), std::string::npos) << e.what();
+  }
+}
+
+TEST(ImageIOFuzzRegressions, AnExrAttributeLargerThanTheFileIsRefusedAtOnce) {
+  // Before: OpenEXR allocated the declared size first; these 44-byte files took 10-33 s.
+  for (const char* name : {"slow_read.exr", "slow_read_2.exr"}) {
+    const auto f = test::source_dir() / "fuzz/regressions/exr" / name;
+    EXPECT_THROW((void)read_exr_rgba(f), Error) << name;
+  }
+  // A real EXR still reads.
+  const auto dir = test::scratch_dir("exr_ok");
+  ImageRGBAF img(3, 2);
+  for (auto& v : img.storage()) v = 0.5f;
+  write_exr(dir / "ok.exr", img);
+  EXPECT_EQ(read_exr_rgba(dir / "ok.exr").width(), 3);
+}

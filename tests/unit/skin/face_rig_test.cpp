@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/context.hpp"
+#include "follicle/core/error.hpp"
 #include "follicle/skin/forehead_validation.hpp"
 #include "follicle/skin/skin_color_bando2002.hpp"
 #include "follicle/skin/skin_json.hpp"
@@ -139,4 +141,19 @@ TEST(SkinJson, MalformedInputFailsCleanly) {
           .find("unknown muscle 'nope'"),
       std::string::npos);
   EXPECT_THROW(wrinkles_from_json_text(R"([{"p0":[0,0]}])"), Error);
+}
+
+TEST(FaceSetupJson, ANumberTooLargeForADoubleIsAFollicleError) {
+  // Fuzzing reproducer (fuzz/regressions/face_setup/number_overflow.json): nlohmann's
+  // out_of_range escaped as a foreign exception (std::terminate in the fuzzer).
+  const std::string text =
+      read_file(test::source_dir() / "fuzz/regressions/face_setup/number_overflow.json");
+  try {
+    (void)face_setup_from_json_text(text, "overflow.json");
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("overflow.json: invalid JSON"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW((void)wrinkles_from_json_text(text, "overflow.json"), Error);
 }

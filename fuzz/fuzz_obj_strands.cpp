@@ -1,0 +1,12 @@
+// libFuzzer target: OBJ polylines (`v` + `l`; geom::obj_to_strands, in memory) + StrandSet::check.
+#include "follicle/geom/strand_io.hpp"
+#include "fuzz_common.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string text = follicle::fuzz::as_string(data, size);
+  follicle::fuzz::expect_ok_or_error([&] {
+    const auto s = follicle::geom::obj_to_strands(text, "fuzz.obj", follicle::LengthUnit::m);
+    if (s.num_strands() > 0) s.check("fuzz.obj");
+  });
+  return 0;
+}
