@@ -64,7 +64,13 @@ function(follicle_test name)
   add_executable(test_${name} ${srcs})
   target_link_libraries(test_${name} PRIVATE ${ARG_LIBS} follicle_testing GTest::gtest GTest::gmock)
   follicle_target_settings(test_${name})
-  set(labels unit ${ARG_LABELS})
+  # One label only: gtest_discover_tests writes PROPERTIES unquoted into its script, so a list
+  # "unit;slow" became LABELS unit plus a stray property "slow" and -LE slow never excluded the
+  # soak. A program with its own label (gl, slow) carries that instead of "unit".
+  set(labels unit)
+  if(ARG_LABELS)
+    list(GET ARG_LABELS 0 labels)
+  endif()
   gtest_discover_tests(test_${name}
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
     PROPERTIES LABELS "${labels}" ENVIRONMENT "FOLLICLE_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
