@@ -13,18 +13,32 @@
 
 namespace follicle {
 
+namespace {
+
+// The folder of an output, created if missing (write_atomically and check_output_writable).
+void create_parent_folder(const std::filesystem::path& path) {
+  if (!path.has_parent_path()) return;
+  std::error_code ec;
+  std::filesystem::create_directories(path.parent_path(), ec);
+  if (ec)
+    fail_at(path.string(), "cannot create directory {}: {}", path.parent_path().string(),
+            ec.message());
+}
+
+// "<path>.tmp-<pid>": where an output is written before the rename.
+std::filesystem::path temporary_path(const std::filesystem::path& path) {
+  std::filesystem::path tmp = path;
+  tmp += ".tmp-" + std::to_string(::getpid());
+  return tmp;
+}
+
+}  // namespace
+
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path& tmp)>& write) {
   namespace fs = std::filesystem;
-  if (path.has_parent_path()) {
-    std::error_code ec;
-    fs::create_directories(path.parent_path(), ec);
-    if (ec)
-      fail_at(path.string(), "cannot create directory {}: {}", path.parent_path().string(),
-              ec.message());
-  }
-  fs::path tmp = path;
-  tmp += ".tmp-" + std::to_string(::getpid());
+  create_parent_folder(path);
+  const fs::path tmp = temporary_path(path);
   const InterruptCleanupFile cleanup(tmp);  // SIGINT / SIGTERM remove it too
   try {
     write(tmp);
@@ -62,15 +76,8 @@ void check_output_writable(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(path, ec)) fail_at(path.string(), "is a folder, expected a file name");
-  if (path.has_parent_path()) {
-    fs::create_directories(path.parent_path(), ec);
-    if (ec)
-      fail_at(path.string(), "cannot create directory {}: {}", path.parent_path().string(),
-              ec.message());
-  }
-  fs::path tmp = path;
-  tmp += ".tmp-" + std::to_string(::getpid());
-  probe_write(tmp, path.string());
+  create_parent_folder(path);
+  probe_write(temporary_path(path), path.string());
 }
 
 void check_output_folder(const std::filesystem::path& dir) {
