@@ -14,7 +14,9 @@ std::unique_ptr<Context> make_context(const GlobalOptions& g) {
   log->set_pattern("follicle: %l: %v");
   log->set_level(g.quiet ? spdlog::level::err
                          : (g.verbose ? spdlog::level::debug : spdlog::level::warn));
-  return std::make_unique<Context>(g.threads, g.seed, log);
+  auto ctx = std::make_unique<Context>(g.threads, g.seed, log);
+  ctx->set_progress(!g.quiet);
+  return ctx;
 }
 
 void parse_frames(const std::string& s, int& first, int& last) {

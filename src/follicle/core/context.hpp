@@ -25,10 +25,16 @@ class Context {
   spdlog::logger& log() const { return *m_log; }
   std::shared_ptr<spdlog::logger> logger_ptr() const { return m_log; }
   tbb::task_arena& arena() const { return *m_arena; }
+  /// Whether long work inside the library (settling hair, growing grooms) may draw a progress bar
+  /// (follicle::Progress, which draws only on a terminal and never in CI). Off by default: a
+  /// program linking Follicle decides; the CLI switches it on unless --quiet.
+  bool progress() const { return m_progress; }
+  void set_progress(bool on) { m_progress = on; }
 
  private:
   int m_threads;
   uint64_t m_seed;
+  bool m_progress = false;
   std::shared_ptr<spdlog::logger> m_log;
   std::unique_ptr<tbb::task_arena> m_arena;
 };

@@ -57,8 +57,10 @@ void Progress::draw(bool final) {
   const double eta = frac > 0 ? secs / frac - secs : 0.0;
   std::string bar(std::size_t(fill), '#');
   bar.resize(width, '.');
-  std::fprintf(stderr, "\r%s [%s] %zu/%zu %5.1fs eta %5.1fs", m_label.c_str(), bar.c_str(), done,
-               m_total, secs, eta);
+  // \x1b[K clears the rest of the line: a bar drawn inside another (settling inside "render")
+  // leaves no tail of the longer one.
+  std::fprintf(stderr, "\r%s [%s] %zu/%zu %5.1fs eta %5.1fs\x1b[K", m_label.c_str(), bar.c_str(),
+               done, m_total, secs, eta);
   std::fflush(stderr);
 }
 

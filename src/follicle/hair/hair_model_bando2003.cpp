@@ -8,6 +8,7 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/log.hpp"
+#include "follicle/core/progress.hpp"
 #include "follicle/core/rng.hpp"
 #include "follicle/geom/sampling.hpp"
 
@@ -282,9 +283,12 @@ class Bando2003Simulation final : public HairSimulation {
     LcpStepInput in;
     in.dt = m_p.settle_time / double(steps);
     LcpWorkspace ws;
+    ctx.log().info("bando2003: settling {} s of simulated time ({} steps)", m_p.settle_time, steps);
+    Progress progress("settling hair", std::size_t(steps), ctx.progress());
     for (long long k = 0; k < steps; ++k) {
       const LcpStepReport r = solver.step(ctx, in, m_start, ws);
       if (!r.ok) fail_at("settle_time", "the hair blew up while settling: {}", r.message);
+      progress.tick();
     }
     std::fill(m_start.v.begin(), m_start.v.end(), Vec3::Zero());
     m_start.time = 0.0;

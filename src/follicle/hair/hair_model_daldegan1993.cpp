@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "follicle/core/error.hpp"
+#include "follicle/core/log.hpp"
+#include "follicle/core/progress.hpp"
 
 namespace follicle::hair {
 
@@ -61,9 +63,14 @@ class Daldegan1993Simulation final : public HairSimulation {
     HingeInput still;
     still.gravity = p.settle_gravity;
     const auto settle_steps = uint64_t(std::llround(p.settle_time / p.hinge.dt));
+    if (settle_steps > 0)
+      ctx.log().info("daldegan1993: settling {} s of simulated time ({} steps)", p.settle_time,
+                     settle_steps);
+    Progress progress("settling hair", std::size_t(settle_steps), ctx.progress());
     for (uint64_t k = 0; k < settle_steps; ++k) {
       const sim::StepReport rep = m_solver->step(ctx, still, m_start);
       if (!rep.ok) fail("settling the styled hair (settle_time) failed: {}", rep.message);
+      progress.tick();
     }
     m_start.step = 0;
     m_start.time = 0.0;

@@ -11,6 +11,7 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
+#include "follicle/core/resources.hpp"
 #include "follicle/core/rng.hpp"
 #include "follicle/hair/sph_kernel.hpp"
 
@@ -360,6 +361,18 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
     double s;
     Vec3 pos;
   };
+  // Resource guard, before any dart is thrown: a saturated Poisson-disc sampling of radius r
+  // fills a 3-D domain at about 0.7 / r^3 points per unit volume (random sequential packing of
+  // spheres of diameter r: density ~0.38 of (pi/6) r^3), and the domain here is the scalp times
+  // the pillar -s_r..L. An estimate far beyond the cap fails now with the numbers; a sampling
+  // that reaches the cap anyway fails below instead of silently leaving the hair unfinished.
+  const double estimate = 0.7 * scalp.area() * (lmax + sr) / (r * r * r);
+  if (estimate > 2.0 * double(p.max_particles))
+    fail_at("lcp_init.max_particles",
+            "the scalp ({:.4g} m^2, hair up to {} m long) at spacing {} m needs about {} "
+            "particles, more than the cap of {} (is the head in metres? a larger spacing or "
+            "shorter hair also help)",
+            scalp.area(), lmax, r, format_count(estimate), format_count(p.max_particles));
   std::vector<Sample> samples;
   std::unordered_map<uint64_t, std::vector<uint32_t>> cells;
   const int max_miss = p.attempts_per_particle * 50;
@@ -400,6 +413,11 @@ LcpInit initialize_lcp(const Context& ctx, const Scalp& scalp, const LcpInitPara
     cells[cell_key(pos, s, r)].push_back(uint32_t(samples.size()));
     samples.push_back({uv, s, pos});
   }
+  if (int(samples.size()) >= p.max_particles && miss < max_miss)
+    fail_at("lcp_init.max_particles",
+            "the hair reached the cap of {} particles before the scalp ({:.4g} m^2) was full at "
+            "spacing {} m; raise the cap or the spacing",
+            p.max_particles, scalp.area(), r);
   if (samples.size() < 2)
     fail_at("lcp_init.spacing", "only {} particle(s) fit the scalp with spacing {} m",
             samples.size(), r);

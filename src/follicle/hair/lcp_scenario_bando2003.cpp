@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "follicle/core/error.hpp"
+#include "follicle/core/log.hpp"
+#include "follicle/core/progress.hpp"
 
 namespace follicle::hair {
 
@@ -202,11 +204,15 @@ void LcpScenario::settle(const Context& ctx, const LcpParams& lcp) {
   const int steps = std::max(1, int(std::lround(m_p.settle_time / dt)));
   LcpStepInput in;
   in.dt = m_p.settle_time / steps;
+  ctx.log().info("lcp: settling {} s of simulated time ({} steps of {} particles)", m_p.settle_time,
+                 steps, m_state.x.size());
+  Progress progress("settling hair", std::size_t(steps), ctx.progress());
   for (int k = 0; k < steps; ++k) {
     in.head.t = m_state.time;
     const LcpStepReport r = solver.step(ctx, in, m_state, m_ws);
     if (!r.ok)
       fail_at("lcp_scenario.settle_time", "the hair blew up while settling: {}", r.message);
+    progress.tick();
   }
   std::fill(m_state.v.begin(), m_state.v.end(), Vec3::Zero());
   m_state.time = 0;

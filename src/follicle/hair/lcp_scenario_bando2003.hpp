@@ -86,7 +86,8 @@ struct LcpScenarioParams {
   LcpMeshHeadParams mesh_head;  // used with a head mesh
   template <class V>
   void visit(V&& v) {
-    v("head_radius", head_radius, ParamInfo{"sphere head radius", "m", 1e-3, 10});
+    v("head_radius", head_radius,
+      ParamInfo{"sphere head radius (a head: 3 cm to 1 m)", "m", 0.03, 1.0});
     v("hair_length", hair_length, ParamInfo{"hair length", "m", 1e-3, 10});
     v("spacing", spacing, ParamInfo{"particle spacing", "m", 1e-4, 1});
     v("total_mass", total_mass, ParamInfo{"hair mass", "kg", 1e-9, 100});

@@ -19,9 +19,30 @@
 #include <string>
 
 #include "follicle/core/atomic_file.hpp"
+#include "follicle/core/resources.hpp"
 
 namespace follicle::image {
 namespace {
+
+// Resource guard: a header may declare any size; a 40-byte file claiming 40000 x 40000 pixels
+// made the decoder allocate gigabytes before it found the data missing. Images are refused above
+// 2^28 pixels (16384 x 16384, far beyond any texture or map Follicle uses) and whenever the decoded
+// image would not fit in the available memory.
+constexpr long long kMaxImagePixels = 1LL << 28;
+
+void check_image_size(const std::string& where, long long w, long long h, int channels,
+                      int bytes_per_channel, const char* format) {
+  if (w <= 0 || h <= 0) fail_at(where, "{} image size {}x{} is invalid", format, w, h);
+  if (w * h > kMaxImagePixels)
+    fail_at(where,
+            "{} image is {}x{} ({} pixels); Follicle reads images of at most {} pixels "
+            "(16384x16384)",
+            format, w, h, format_count(double(w) * double(h)),
+            format_count(double(kMaxImagePixels)));
+  // The decoder's buffer and our copy of it.
+  check_memory(where, fmt::format("decoding the {}x{} {} image", w, h, format),
+               2.0 * double(w) * double(h) * channels * bytes_per_channel, "");
+}
 
 struct StbFree {
   void operator()(unsigned char* p) const { stbi_image_free(p); }
@@ -68,6 +89,9 @@ Image<uint8_t, C> read_stb(const std::filesystem::path& path) {
   if (bytes.size() > std::size_t(INT32_MAX)) fail_at(path.string(), "file too large");
   check_jpeg_huffman_tables(bytes, path.string());
   int w = 0, h = 0, n = 0;
+  if (stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w,
+                            &h, &n))
+    check_image_size(path.string(), w, h, C, 1, "PNG/JPEG");
   std::unique_ptr<unsigned char, StbFree> px(stbi_load_from_memory(
       reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w, &h, &n, C));
   if (!px) {
@@ -122,8 +146,9 @@ void write_exr_impl(const std::filesystem::path& path, const Image<float, C>& im
 // OpenEXR 3.1 allocates whatever size a header attribute declares before it notices the file
 // is shorter (a 44-byte file took 10-33 s; found by fuzz/fuzz_exr, reproducers in
 // fuzz/regressions/exr/). The attribute list is walked first: every declared size must fit in
-// the file.
-void check_exr_header(const std::string& b, const std::string& where) {
+// the file. The data window found on the way is checked against the image size guard before
+// OpenEXR reads the line offsets or we allocate the pixels.
+void check_exr_header(const std::string& b, const std::string& where, int channels) {
   if (b.size() < 8 || b.compare(0, 4, "\x76\x2f\x31\x01") != 0)
     fail_at(where, "not an OpenEXR file (bad magic number)");
   if (uint8_t(b[5]) & 0x10) return;  // multi-part: several headers; OpenEXR checks those itself
@@ -142,6 +167,12 @@ void check_exr_header(const std::string& b, const std::string& where) {
     if (size < 0 || std::size_t(size) > b.size() - pos)
       fail_at(where, "EXR header attribute \"{}\" declares {} bytes but the file has {} left", name,
               size, b.size() - pos);
+    if (name == "dataWindow" && size == 16) {
+      int32_t box[4];  // xmin, ymin, xmax, ymax
+      std::memcpy(box, b.data() + pos, sizeof box);
+      check_image_size(where, (long long)box[2] - box[0] + 1, (long long)box[3] - box[1] + 1,
+                       channels, int(sizeof(float)), "EXR");
+    }
     pos += std::size_t(size);
   }
 }
@@ -153,15 +184,14 @@ Image<float, C> read_exr_impl(const std::filesystem::path& path,
                               const std::vector<std::vector<std::string>>& wanted,
                               const float* fill) {
   if (!std::filesystem::exists(path)) fail_at(path.string(), "cannot open: no such file");
-  check_exr_header(read_file(path), path.string());
+  check_exr_header(read_file(path), path.string(), C);
   try {
     Imf::InputFile file(path.string().c_str());
     const Imath::Box2i dw = file.header().dataWindow();
     const long long w = (long long)dw.max.x - dw.min.x + 1;
     const long long h = (long long)dw.max.y - dw.min.y + 1;
-    if (w <= 0 || h <= 0 || w * h > (1LL << 31)) {
-      fail_at(path.string(), "EXR data window {}x{} is invalid", w, h);
-    }
+    if (w <= 0 || h <= 0) fail_at(path.string(), "EXR data window {}x{} is invalid", w, h);
+    check_image_size(path.string(), w, h, C, int(sizeof(float)), "EXR");
     Image<float, C> img{int(w), int(h)};
     Imf::FrameBuffer fb;
     const std::size_t xs = sizeof(float) * C, ys = xs * std::size_t(w);

@@ -19,6 +19,7 @@
 #include <numeric>
 
 #include "follicle/core/parallel.hpp"
+#include "follicle/core/resources.hpp"
 #include "follicle/render/camera.hpp"
 #include "follicle/render/egl_context.hpp"
 #include "follicle/render/gl_util.hpp"
@@ -44,12 +45,25 @@ struct FrameObjects {
     if (!vaos.empty()) glDeleteVertexArrays(GLsizei(vaos.size()), vaos.data());
     if (!textures.empty()) glDeleteTextures(GLsizei(textures.size()), textures.data());
   }
+  // Resource guard: the size is checked against the available memory before the upload (a
+  // software GL such as llvmpipe keeps buffers in system memory; 6.9 M strands once ended in
+  // "OpenGL error 0x505 during upload" after minutes), and an out-of-memory answer of the driver
+  // is reported with the size instead of as a bare error code.
   GLuint buffer(GLenum target, std::size_t bytes, const void* data) {
+    check_memory("render", fmt::format("uploading {} of geometry", format_bytes(double(bytes))),
+                 double(bytes), "draw fewer strands (hair[].density_scale) or a smaller mesh");
     GLuint b = 0;
     glGenBuffers(1, &b);
     buffers.push_back(b);
     glBindBuffer(target, b);
     glBufferData(target, GLsizeiptr(bytes), data, GL_STATIC_DRAW);
+    const GLenum e = glGetError();
+    if (e == GL_OUT_OF_MEMORY)
+      fail("render: the GL driver ran out of memory uploading {} of geometry",
+           format_bytes(double(bytes)));
+    if (e != GL_NO_ERROR)
+      fail("render: OpenGL error 0x{:x} uploading {} of geometry", unsigned(e),
+           format_bytes(double(bytes)));
     return b;
   }
   GLuint vao() {
@@ -336,6 +350,11 @@ class GlRenderer final : public Renderer {
            fw, fh, lim);
     if (shadow_size > max_tex)
       fail("render: shadow_map_size {} exceeds GL_MAX_TEXTURE_SIZE {}", shadow_size, max_tex);
+    // The supersampled colour (RGBA16F) and depth, the output and its read-back, the shadow map.
+    check_memory(
+        "render", fmt::format("a {}x{} framebuffer at supersample {}", w, h, k),
+        double(fw) * fh * (8 + 4) + double(w) * h * 8 + double(shadow_size) * shadow_size * 4,
+        "lower render.supersample or the image size");
     if (fw != m_fb_w || fh != m_fb_h || w != m_out_w || h != m_out_h) {
       const int keep_shadow = m_shadow_size;
       GLuint sfbo = m_shadow_fbo, stex = m_shadow_tex;
@@ -411,6 +430,11 @@ class GlRenderer final : public Renderer {
       m_tex_cache.erase(it);
     }
     if (img->empty()) fail("render: empty texture image");
+    GLint max_tex = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    if (img->width() > max_tex || img->height() > max_tex)
+      fail("render: a {}x{} texture exceeds this GL's GL_MAX_TEXTURE_SIZE of {}; scale it down",
+           img->width(), img->height(), max_tex);
     GLuint t = 0;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);

@@ -119,6 +119,7 @@ struct HairGroupSpec {
   sim::EllipsoidFitParams hull_fit;
   HairStyleSpec style;
   double density_scale = 1.0;
+  double max_strands = 2e6;  // budget: a style that would grow more fails before growing
   hair::ProjectiveParams dynamics;
   hair::DaldeganParams daldegan;
   hair::BandoParams bando;
@@ -150,6 +151,10 @@ struct HairGroupSpec {
                 "name or full style (Anjyo 1992 §2)"});
     v("density_scale", density_scale,
       ParamInfo{"multiplies every pore density of the style (previews, tests)", "", 1e-4, 100.0});
+    v("max_strands", max_strands,
+      ParamInfo{"budget of strands: a style or groom with more is refused before it grows (or, "
+                "imported, before it is simulated), naming the count",
+                "", 1.0, 1e8});
     v("dynamics", dynamics, ParamInfo{"projective dynamics of model anjyo1992 (Anjyo 1992 §3)"});
     v("daldegan", daldegan,
       ParamInfo{"hinge dynamics, body collision and wisps of model daldegan1993 (Daldegan 1993 "

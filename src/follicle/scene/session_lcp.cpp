@@ -30,7 +30,10 @@ std::shared_ptr<const geom::ParticleSet> Session::lcp_particles(int frame) {
   if (!m_lcp) m_lcp = std::make_shared<LcpRuntime>();
   LcpRuntime& rt = *m_lcp;
   if (rt.last && rt.last_frame == frame) return rt.last;
-  if (!rt.ctx) rt.ctx = std::make_unique<Context>(m_ctx->threads(), spec.seed, m_ctx->logger_ptr());
+  if (!rt.ctx) {
+    rt.ctx = std::make_unique<Context>(m_ctx->threads(), spec.seed, m_ctx->logger_ptr());
+    rt.ctx->set_progress(m_ctx->progress());
+  }
   const Context& ctx = *rt.ctx;
   if (!m_scene.animation && frame > 0)
     fail_at(m_source, "frame {} of a still scene (add an \"animation\" section)", frame);

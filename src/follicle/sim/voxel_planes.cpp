@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "follicle/core/error.hpp"
+#include "follicle/core/resources.hpp"
 #include "follicle/core/rng.hpp"
 
 namespace follicle::sim {
@@ -32,6 +33,29 @@ VoxelPlanes VoxelPlanes::build(const std::vector<const geom::TriMesh*>& meshes,
     Vec3 n = Vec3::Zero();
     int count = 0;
   };
+  // Resource guard: the sample count is known from the area before any sampling (a sphere head
+  // of 10 m radius asked for 178 M samples and ran for minutes with growing memory).
+  double total_area = 0;
+  for (const geom::TriMesh* m : meshes) {
+    if (!m) continue;
+    for (const Vec3i& fc : m->faces) {
+      bool in_range = true;
+      for (int k = 0; k < 3; ++k)
+        in_range = in_range && fc[k] >= 0 && std::size_t(fc[k]) < m->positions.size();
+      if (!in_range) continue;  // reported below with the face number
+      total_area += 0.5 * (m->positions[fc[1]] - m->positions[fc[0]])
+                              .cross(m->positions[fc[2]] - m->positions[fc[0]])
+                              .norm();
+    }
+  }
+  const double expected = total_area * density;
+  if (!(expected <= params.max_samples))
+    fail_at("voxel_planes.max_samples",
+            "the body's surface of {:.4g} m^2 at voxel_size {} m needs {} samples, more than the "
+            "budget of {} (is the body in metres? a larger voxel_size or fewer samples_per_voxel "
+            "also help)",
+            total_area, params.voxel_size, format_count(expected),
+            format_count(params.max_samples));
   std::unordered_map<uint64_t, Acc> acc;
   Rng rng = Rng::stream(seed, 0x564f58ull);
   for (std::size_t mi = 0; mi < meshes.size(); ++mi) {

@@ -16,11 +16,14 @@ namespace follicle::sim {
 struct VoxelPlanesParams {
   double voxel_size = 0.01;         // [m] edge of a voxel
   double samples_per_voxel = 24.0;  // sample density = samples_per_voxel / voxel_size^2
+  double max_samples = 2e7;         // budget: a larger body fails before sampling
   template <class V>
   void visit(V&& v) {
     v("voxel_size", voxel_size, ParamInfo{"voxel edge length", "m", 1e-5, 10.0});
     v("samples_per_voxel", samples_per_voxel,
       ParamInfo{"surface samples per voxel-sized area", "", 1.0, 1e4});
+    v("max_samples", max_samples,
+      ParamInfo{"budget of surface samples (refused before sampling)", "", 1.0, 1e9});
   }
   void validate() const { validate_params(*this, "voxel_planes"); }
 };

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "follicle/core/error.hpp"
+#include "follicle/core/resources.hpp"
 
 namespace follicle::skin {
 
@@ -62,6 +63,15 @@ RefinedMesh refine_around_wrinkles(const geom::TriMesh& base,
       }
     }
     if (split.empty()) break;
+    // Resource guard: a split edge adds at most two triangles (one per incident face). Level 5 of
+    // 8 at edge_factor 0.05 on the hand asked for tens of millions and ran for minutes.
+    const double next = double(m.faces.size()) + 2.0 * double(split.size());
+    if (next > params.max_triangles)
+      fail_at("refine.max_triangles",
+              "refinement level {} of {} would make up to {} triangles, more than the budget of "
+              "{}; raise edge_factor (now {}), lower max_levels or region_widths (now {})",
+              level + 1, params.max_levels, format_count(next), format_count(params.max_triangles),
+              params.edge_factor, params.region_widths);
     // New vertices in a deterministic order (sorted edge keys).
     std::vector<uint64_t> keys;
     keys.reserve(split.size());

@@ -23,6 +23,7 @@ struct RefineParams {
   double edge_factor = 0.5;    // target edge length = edge_factor * wrinkle width
   double region_widths = 6.0;  // refine within this many widths of the furrow
   bool smooth = true;  // new vertices on the curved (PN-triangle) edge, not the flat midpoint
+  double max_triangles = 4e6;  // budget: a level that would exceed it fails before splitting
   template <class V>
   void visit(V&& v) {
     v("smooth", smooth,
@@ -31,6 +32,9 @@ struct RefineParams {
     v("edge_factor", edge_factor, ParamInfo{"target edge length / wrinkle width", "", 0.05, 10.0});
     v("region_widths", region_widths,
       ParamInfo{"refined band half-width in wrinkle widths", "", 0.0, 50.0});
+    v("max_triangles", max_triangles,
+      ParamInfo{"budget of triangles after refinement (refused before a level exceeds it)", "", 1e3,
+                1e8});
   }
   void validate() const { validate_params(*this, "refine"); }
 };

@@ -180,3 +180,10 @@ TEST(Cpu, Avx2CheckAgreesWithTheKernelsCpuFlags) {
   if (!found) GTEST_SKIP() << "no flags line (not x86)";
   EXPECT_EQ(a, listed);
 }
+
+TEST(Context, LibraryProgressBarsAreOffUnlessTheProgramAsks) {
+  Context ctx(1);
+  EXPECT_FALSE(ctx.progress());  // a program linking Follicle draws nothing unasked
+  ctx.set_progress(true);
+  EXPECT_TRUE(ctx.progress());
+}

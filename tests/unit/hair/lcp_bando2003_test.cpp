@@ -501,3 +501,36 @@ TEST(LcpInit, StrandBlockLayout) {
   EXPECT_EQ(roots, 12);
   EXPECT_TRUE(lcp_strand_block(0, 2, 4, a).x.empty());
 }
+
+TEST(LcpInit, TheParticleEstimateAgreesWithTheSamplingAndABudgetFarBelowIsRefusedAtOnce) {
+  Context ctx(2);
+  auto sc = test::lcp_small_scene(ctx);
+  // The estimate the guard uses, 0.7 area (L + s_r) / r^3, is within a factor 2 of the count.
+  const double r = 0.012;
+  const double estimate =
+      0.7 * sc.scalp.area() * (sc.scalp.max_length() + sc.scalp.root_depth()) / (r * r * r);
+  const double n = double(sc.init.model.size());
+  EXPECT_GT(estimate, 0.5 * n);
+  EXPECT_LT(estimate, 2.0 * n);
+  hair::LcpInitParams ip;
+  ip.spacing = r;
+  ip.whirl_point = Vec3(0, 0.1, 0.02);
+  // Far below: refused before sampling, naming the estimate and the cap.
+  ip.max_particles = int(n / 10);
+  try {
+    (void)hair::initialize_lcp(ctx, sc.scalp, ip, &sc.body);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.where(), "lcp_init.max_particles");
+    EXPECT_NE(std::string(e.what()).find("needs about"), std::string::npos) << e.what();
+  }
+  // Just below the real count: the sampling reaches the cap; before, it stopped there silently
+  // and the hair had bald patches.
+  ip.max_particles = int(0.8 * n);
+  try {
+    (void)hair::initialize_lcp(ctx, sc.scalp, ip, &sc.body);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("reached the cap"), std::string::npos) << e.what();
+  }
+}

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <fstream>
 #include <limits>
 
@@ -220,4 +221,69 @@ TEST(ImageIOFuzzRegressions, AnExrAttributeLargerThanTheFileIsRefusedAtOnce) {
   for (auto& v : img.storage()) v = 0.5f;
   write_exr(dir / "ok.exr", img);
   EXPECT_EQ(read_exr_rgba(dir / "ok.exr").width(), 3);
+}
+
+namespace {
+// Overwrites the dataWindow box of an EXR written by write_exr with (0, 0)-(w-1, h-1).
+std::string with_exr_data_window(std::string b, int32_t w, int32_t h) {
+  const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+  const std::size_t at = b.find(key);
+  if (at == std::string::npos) return {};
+  const std::size_t box = at + key.size() + 4;  // after the 4-byte attribute size
+  const int32_t v[4] = {0, 0, w - 1, h - 1};
+  std::memcpy(b.data() + box, v, sizeof v);
+  return b;
+}
+}  // namespace
+
+TEST(ImageIOResourceGuards, AnExrDeclaringHugePixelsIsRefusedBeforeAllocating) {
+  // Before: a 3x2 file claiming 40000x40000 made the reader allocate 25.6 GB of floats.
+  const auto dir = test::scratch_dir("exr_huge");
+  ImageRGBAF img(3, 2);
+  for (auto& v : img.storage()) v = 0.25f;
+  write_exr(dir / "small.exr", img);
+  const std::string huge = with_exr_data_window(read_file(dir / "small.exr"), 40000, 40000);
+  ASSERT_FALSE(huge.empty());
+  write_bytes(dir / "huge.exr", huge);
+  for (int gray = 0; gray < 2; ++gray) {
+    try {
+      if (gray) {
+        (void)read_exr_gray(dir / "huge.exr");
+      } else {
+        (void)read_exr_rgba(dir / "huge.exr");
+      }
+      FAIL() << "accepted";
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("40000x40000"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("at most 268 M pixels"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("huge.exr"), std::string::npos) << msg;
+    }
+  }
+  // The unchanged file still reads.
+  EXPECT_EQ(read_exr_rgba(dir / "small.exr").width(), 3);
+}
+
+TEST(ImageIOResourceGuards, APngDeclaringHugePixelsIsRefusedBeforeDecoding) {
+  // A PNG header (IHDR) of 20000 x 20000 grey with no image data. (stb refuses RGBA above
+  // 2^28 pixels itself, "too large"; a grey image it would decode up to 2^30 pixels.)
+  auto be32 = [](uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+  };
+  std::string png = "\x89PNG\r\n\x1a\n";
+  png += be32(13) + "IHDR" + be32(20000) + be32(20000) + std::string("\x08\x00\x00\x00\x00", 5);
+  png += be32(0);  // CRC (stb does not check it)
+  png += be32(0) + "IEND" + be32(0);
+  const auto dir = test::scratch_dir("png_huge");
+  write_bytes(dir / "huge.png", png);
+  try {
+    (void)read_png_rgba(dir / "huge.png");
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("PNG/JPEG image is 20000x20000 (400 M pixels); Follicle reads images of at "
+                       "most 268 M pixels"),
+              std::string::npos)
+        << msg;
+  }
 }

@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -207,4 +208,29 @@ TEST(GroomScene, EveryModelRunsTheSameGroomAndCachesItThreadIndependently) {
     EXPECT_EQ(bytes[0].size(), 4u) << model;
     EXPECT_TRUE(bytes[0] == bytes[1]) << model << ": the cache differs between 1 and 2 threads";
   }
+}
+
+TEST(GroomScene, TheStrandBudgetRefusesAStyleBeforeItGrowsAndAGroomBeforeItRuns) {
+  const Context ctx(2, 1);
+  // A generated style: the pore estimate is checked before any strand grows.
+  Json j = scene_json("anjyo_bob");
+  j["hair"][0]["density_scale"] = 0.03;
+  Session full = Session::from_json(j, scenes_dir(), "anjyo_bob", ctx);
+  const double grown = double(full.hair_strands(0, 0)->num_strands());
+  ASSERT_GT(grown, 100.0);
+  j["hair"][0]["max_strands"] = std::floor(grown / 2);
+  const std::string style_error = session_error(j, ctx);
+  EXPECT_THAT(style_error, HasSubstr("max_strands: the style would grow about"));
+  EXPECT_THAT(style_error, HasSubstr("lower density_scale"));
+  j["hair"][0]["max_strands"] = std::ceil(grown * 1.5);  // the estimate is within 50 %
+  EXPECT_EQ(session_error(j, ctx), "");
+  // An imported groom: refused before it is simulated.
+  const auto dir = test::scratch_dir("groom_budget");
+  const geom::StrandSet ref = write_bob_groom(dir / "bob.hair", ctx);
+  Json g = groom_scene(dir / "bob.hair", "mm");
+  g["hair"][0]["max_strands"] = double(ref.num_strands() - 1);
+  EXPECT_THAT(session_error(g, ctx),
+              HasSubstr(fmt::format("max_strands: the groom has {} strands", ref.num_strands())));
+  g["hair"][0]["max_strands"] = double(ref.num_strands());
+  EXPECT_EQ(session_error(g, ctx), "");
 }

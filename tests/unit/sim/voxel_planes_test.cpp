@@ -177,3 +177,22 @@ TEST(VoxelPlanes, BadMeshesFailCleanly) {
   p.voxel_size = -1;
   EXPECT_THROW(VoxelPlanes::build({&bad}, p, 1), Error);
 }
+
+TEST(VoxelPlanes, ABodyTooLargeForTheSampleBudgetIsRefusedBeforeSampling) {
+  // A 10 m sphere head at 1.3 cm voxels asked for 178 M samples and ran for minutes.
+  const geom::TriMesh big = sphere(Vec3::Zero(), 10.0, 8, 16);
+  VoxelPlanesParams p;
+  p.voxel_size = 0.013;
+  try {
+    (void)VoxelPlanes::build({&big}, p, 1);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(e.where(), "voxel_planes.max_samples");
+    EXPECT_NE(msg.find("needs 1"), std::string::npos) << msg;  // 1xx M samples
+    EXPECT_NE(msg.find(" M samples, more than the budget of 20.0 M"), std::string::npos) << msg;
+  }
+  // The same at head size builds.
+  const geom::TriMesh head = sphere(Vec3::Zero(), 0.1, 8, 16);
+  EXPECT_GT(VoxelPlanes::build({&head}, p, 1).num_planes(), 0u);
+}

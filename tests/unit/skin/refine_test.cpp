@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "follicle/core/error.hpp"
 #include "follicle/skin/adaptive_refine_volino1999.hpp"
 #include "follicle/skin/forehead_validation.hpp"
 
@@ -73,4 +74,30 @@ TEST(Refine, SmoothMidpointsLieOnTheCurvedSurface) {
   EXPECT_GT(ea, 1e-6);
   EXPECT_LT(eb, 0.25 * ea);
   EXPECT_EQ(count_t_junctions(b.mesh, 1e-3), 0);
+}
+
+TEST(Refine, ALevelBeyondTheTriangleBudgetIsRefusedNamingTheFix) {
+  // max_levels 8 at edge_factor 0.05 on the hand ran for minutes with growing memory.
+  const geom::TriMesh base = make_cylinder_patch(0.05, 0.04, 0.08, 0.004);
+  LargeWrinkle w;
+  w.control = {Vec2(0.2, 0.3), Vec2(0.4, 0.45), Vec2(0.6, 0.35), Vec2(0.8, 0.5)};
+  w.width = 0.002;
+  RefineParams rp;
+  rp.max_levels = 8;
+  rp.edge_factor = 0.05;
+  rp.max_triangles = 20000;
+  try {
+    (void)refine_around_wrinkles(base, {w}, rp);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(e.where(), "refine.max_triangles");
+    EXPECT_NE(msg.find("more than the budget of 20.0 k; raise edge_factor (now 0.05)"),
+              std::string::npos)
+        << msg;
+  }
+  // Within the budget the same refinement runs, and stays under it.
+  rp.max_levels = 2;
+  const RefinedMesh r = refine_around_wrinkles(base, {w}, rp);
+  EXPECT_LE(double(r.mesh.faces.size()), rp.max_triangles);
 }
