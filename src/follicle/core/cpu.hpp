@@ -4,6 +4,18 @@
 // kernels; the particle grid's distance filter). One place, so every dispatcher asks the same
 // question the same way.
 
+// FOLLICLE_AVX2_BEGIN ... FOLLICLE_AVX2_END: the functions in between are compiled for AVX2
+// (no FMA), for g++ by `#pragma GCC target` and for clang, which ignores that pragma, by
+// `#pragma clang attribute` (the fuzz build, tools/fuzz.sh). Callers dispatch on cpu_has_avx2().
+#if defined(__clang__)
+#define FOLLICLE_AVX2_BEGIN \
+  _Pragma("clang attribute push(__attribute__((target(\"avx2\"))), apply_to = function)")
+#define FOLLICLE_AVX2_END _Pragma("clang attribute pop")
+#else
+#define FOLLICLE_AVX2_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx2\")")
+#define FOLLICLE_AVX2_END _Pragma("GCC pop_options")
+#endif
+
 namespace follicle {
 
 /// Whether the CPU running this process has AVX2 (always false where the check is not available:

@@ -241,9 +241,8 @@ void air_drag(const AirDragInputs& in, std::size_t i0, std::size_t i1, Vec3* f) 
 }
 
 #ifdef FOLLICLE_LCP_KERNELS_HAVE_AVX2
-#pragma GCC push_options
+FOLLICLE_AVX2_BEGIN
 // AVX2 without FMA: no contraction, so each lane rounds exactly as the scalar code.
-#pragma GCC target("avx2")
 namespace avx2 {
 
 // Hand-written SIMD (no library in the stack gathers from an array of Vec3): GCC vector
@@ -567,7 +566,7 @@ void air_drag(const AirDragInputs& in, std::size_t i0, std::size_t i1, Vec3* f) 
 }
 
 }  // namespace avx2
-#pragma GCC pop_options
+FOLLICLE_AVX2_END
 #endif
 
 LcpKernels lcp_kernels(bool allow_simd) {

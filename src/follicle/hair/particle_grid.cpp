@@ -257,8 +257,7 @@ constexpr CompactTable kCompact = make_compact_table();
 /// so the same decisions), a lane mask compacted by a byte shuffle and stored unaligned (o must
 /// have room for 4 entries past the count). The last 1-3 slots of a range are read by masked
 /// loads.
-#pragma GCC push_options
-#pragma GCC target("avx2")
+FOLLICLE_AVX2_BEGIN
 uint32_t filter_avx2(const detail::CellTable& g, const Range* rg, std::size_t nr, double px,
                      double py, double pz, double r2, uint32_t self, uint32_t* __restrict o) {
   const double* cx = g.x.data();
@@ -296,7 +295,7 @@ uint32_t filter_avx2(const detail::CellTable& g, const Range* rg, std::size_t nr
   }
   return cnt;
 }
-#pragma GCC pop_options
+FOLLICLE_AVX2_END
 #endif
 
 bool have_avx2() {

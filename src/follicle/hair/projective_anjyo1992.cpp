@@ -190,15 +190,14 @@ constexpr std::size_t kVecBytes = 16;
 }  // namespace sse2
 
 #if defined(__x86_64__) && defined(__GNUC__)
-#pragma GCC push_options
-#pragma GCC target("avx2")
+FOLLICLE_AVX2_BEGIN
 namespace avx2 {
 constexpr std::size_t kVecBytes = 32;
 #define FOLLICLE_PROJECTIVE_AVX2 1
 #include "follicle/hair/projective_anjyo1992_kernel.inc"
 #undef FOLLICLE_PROJECTIVE_AVX2
 }  // namespace avx2
-#pragma GCC pop_options
+FOLLICLE_AVX2_END
 #define FOLLICLE_PROJECTIVE_HAVE_AVX2 1
 #endif
 

@@ -272,6 +272,11 @@ void CylinderTable::mark_candidates(const float* __restrict px, const float* __r
   }
 }
 
+void CylinderBody::mark_candidates(const float* px, const float* py, const float* pz, std::size_t n,
+                                   float extra, int* flag) const {
+  for (const CylinderTable& t : m_parts) t.mark_candidates(px, py, pz, n, extra, flag);
+}
+
 CylinderQuery CylinderTable::query(const Vec3& p, double extra) const {
   CylinderQuery q;
   q.part = 0;

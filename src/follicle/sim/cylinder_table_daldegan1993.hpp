@@ -203,10 +203,10 @@ class CylinderBody {
   CylinderQuery query(const Vec3& p, double extra = 0.0) const;
   bool inside(const Vec3& p, double extra = 0.0) const;
   /// mark_candidates() of every part (flag[k] = 1 where some part may touch point k).
+  /// (Defined in the .cpp after CylinderTable::mark_candidates: clang refuses a target_clones
+  /// function used before its definition.)
   void mark_candidates(const float* px, const float* py, const float* pz, std::size_t n,
-                       float extra, int* flag) const {
-    for (const CylinderTable& t : m_parts) t.mark_candidates(px, py, pz, n, extra, flag);
-  }
+                       float extra, int* flag) const;
   /// contact() of the deepest part (inside the grown surface first, then the smallest
   /// distance); -1 when none.
   inline int contact(float px, float py, float pz, float extra, CylinderContactF& c) const;

@@ -84,7 +84,8 @@ anim::SkinWeights propagate_weights(const anim::SkinWeights& w, const RefinedMes
     std::vector<std::pair<int, float>> m;
     for (int c = 0; c < 2; ++c)
       for (const auto& [b, x] : lists[std::size_t(p[c])]) {
-        auto it = std::find_if(m.begin(), m.end(), [&](const auto& e) { return e.first == b; });
+        const int bone = b;  // (a structured binding in a lambda capture needs clang 16)
+        auto it = std::find_if(m.begin(), m.end(), [&](const auto& e) { return e.first == bone; });
         if (it == m.end())
           m.emplace_back(b, 0.5f * x);
         else
