@@ -87,6 +87,15 @@ Image<uint8_t, C> read_stb(const std::filesystem::path& path) {
   const std::string bytes = read_file(path);
   if (bytes.empty()) fail_at(path.string(), "empty file, expected a PNG or JPEG image");
   if (bytes.size() > std::size_t(INT32_MAX)) fail_at(path.string(), "file too large");
+  // Only the formats Follicle documents: stb also decodes TGA, BMP, PSD, GIF, HDR, PIC and PNM,
+  // and a 120-byte file taken for an RLE TGA of 65496 x 224 pixels decoded for seconds (found by
+  // fuzz/fuzz_png; fuzz/regressions/png/tga_decompression_bomb.bin).
+  const bool png = bytes.size() >= 8 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0;
+  const bool jpeg = bytes.size() >= 3 && bytes.compare(0, 3, "\xff\xd8\xff") == 0;
+  if (!png && !jpeg)
+    fail_at(path.string(),
+            "not a PNG or JPEG file (it starts with neither the PNG signature nor a JPEG start "
+            "of image)");
   check_jpeg_huffman_tables(bytes, path.string());
   int w = 0, h = 0, n = 0;
   if (stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w,
@@ -167,6 +176,29 @@ void check_exr_header(const std::string& b, const std::string& where, int channe
     if (size < 0 || std::size_t(size) > b.size() - pos)
       fail_at(where, "EXR header attribute \"{}\" declares {} bytes but the file has {} left", name,
               size, b.size() - pos);
+    // OpenEXR parses a channel list and a preview by their content, not by the declared size,
+    // and goes on reading where the content ends: a file whose declared size differs put OpenEXR
+    // out of step with this walk and made it allocate a 221 MB "attribute" from the pixels that
+    // followed (fuzz/regressions/exr/window_without_offsets.exr). Such files are refused.
+    const std::string type = b.substr(name_end + 1, type_end - name_end - 1);
+    if (type == "chlist") {
+      std::size_t q = pos;
+      const std::size_t end = pos + std::size_t(size);
+      while (q < end && b[q] != '\0') {
+        const std::size_t z = b.find('\0', q);
+        if (z == std::string::npos || z >= end) break;
+        q = z + 1 + 16;  // pixel type, pLinear + 3 reserved, x and y sampling
+      }
+      if (q + 1 != end)
+        fail_at(where, "EXR channel list declares {} bytes but its channels take {}", size,
+                q + 1 - pos);
+    } else if (type == "preview") {
+      uint32_t wh[2] = {0, 0};
+      if (size >= 8) std::memcpy(wh, b.data() + pos, 8);
+      if (size < 8 || double(wh[0]) * wh[1] * 4 + 8 != double(size))
+        fail_at(where, "EXR preview image of {}x{} does not match its {} bytes", wh[0], wh[1],
+                size);
+    }
     if (name == "dataWindow" && size == 16) {
       int32_t box[4];  // xmin, ymin, xmax, ymax
       std::memcpy(box, b.data() + pos, sizeof box);
@@ -192,6 +224,10 @@ Image<float, C> read_exr_impl(const std::filesystem::path& path,
     const long long h = (long long)dw.max.y - dw.min.y + 1;
     if (w <= 0 || h <= 0) fail_at(path.string(), "EXR data window {}x{} is invalid", w, h);
     check_image_size(path.string(), w, h, C, int(sizeof(float)), "EXR");
+    // Before the pixels are allocated: a 132-byte file without its line offsets declared a
+    // window of ~2^28 pixels and had 4 GB zeroed before isComplete() refused it (found by
+    // fuzz/fuzz_exr; fuzz/regressions/exr/window_without_offsets.exr).
+    if (!file.isComplete()) fail_at(path.string(), "EXR file is incomplete (truncated)");
     Image<float, C> img{int(w), int(h)};
     Imf::FrameBuffer fb;
     const std::size_t xs = sizeof(float) * C, ys = xs * std::size_t(w);
@@ -213,7 +249,6 @@ Image<float, C> read_exr_impl(const std::filesystem::path& path,
     }
     if (!any) fail_at(path.string(), "EXR has none of the expected channels (Y or R,G,B,A)");
     file.setFrameBuffer(fb);
-    if (!file.isComplete()) fail_at(path.string(), "EXR file is incomplete (truncated)");
     file.readPixels(dw.min.y, dw.max.y);
     return img;
   } catch (const Error&) {

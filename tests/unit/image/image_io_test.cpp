@@ -6,6 +6,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
@@ -286,4 +287,38 @@ TEST(ImageIOResourceGuards, APngDeclaringHugePixelsIsRefusedBeforeDecoding) {
               std::string::npos)
         << msg;
   }
+}
+
+TEST(ImageIOFuzzRegressions, OnlyPngAndJpegAreDecodedSoATgaBombIsRefusedAtOnce) {
+  // Before: stb took these 120 bytes for an RLE TGA of 65496 x 224 pixels and decoded for
+  // seconds (under ASan 5-11 s). Follicle documents PNG and JPEG only.
+  const auto f = test::source_dir() / "fuzz/regressions/png/tga_decompression_bomb.bin";
+  try {
+    (void)read_png_rgba(f);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a PNG or JPEG file"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)read_gray_map(f), Error);
+}
+
+TEST(ImageIOFuzzRegressions, AnExrWithoutItsLineOffsetsIsRefusedBeforeThePixelsAreAllocated) {
+  // Before: 132 bytes declaring a large window had gigabytes zeroed before isComplete() said no.
+  const auto f = test::source_dir() / "fuzz/regressions/exr/window_without_offsets.exr";
+  try {
+    (void)read_exr_rgba(f);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(f.string()), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)read_exr_gray(f), Error);
+  // The header checks keep every valid file of the seed corpus (compressions none, RLE, ZIPS,
+  // ZIP, PIZ, PXR24, B44, a tiled file; half, float and uint channels) readable.
+  int n = 0;
+  for (const auto& e :
+       std::filesystem::directory_iterator(test::source_dir() / "fuzz/corpus/exr")) {
+    EXPECT_NO_THROW((void)read_exr_rgba(e.path())) << e.path();
+    ++n;
+  }
+  EXPECT_GE(n, 7);
 }
