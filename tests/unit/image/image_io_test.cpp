@@ -1,5 +1,11 @@
 #include "follicle/image/image_io.hpp"
 
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
+#include <OpenEXR/ImfPartType.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
@@ -300,6 +306,44 @@ TEST(ImageIOFuzzRegressions, OnlyPngAndJpegAreDecodedSoATgaBombIsRefusedAtOnce) 
     EXPECT_NE(std::string(e.what()).find("not a PNG or JPEG file"), std::string::npos) << e.what();
   }
   EXPECT_THROW((void)read_gray_map(f), Error);
+}
+
+TEST(ImageIOFuzzRegressions, AMultiPartExrHasEveryHeaderChecked) {
+  // Before: multi-part headers were left to OpenEXR; this 177-byte file took 20 s and gigabytes.
+  const auto f = test::source_dir() / "fuzz/regressions/exr/multipart_attribute_size.exr";
+  try {
+    (void)read_exr_rgba(f);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("declares 1851877465 bytes but the file has 144 left"),
+              std::string::npos)
+        << e.what();
+  }
+  // A valid two-part file (written by OpenEXR) still reads: its first part.
+  const auto dir = test::scratch_dir("exr_multipart");
+  const auto ok = dir / "two_parts.exr";
+  {
+    std::vector<Imf::Header> headers;
+    for (const char* name : {"first", "second"}) {
+      Imf::Header h(3, 2);
+      h.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+      h.setName(name);
+      h.setType(Imf::SCANLINEIMAGE);
+      headers.push_back(h);
+    }
+    Imf::MultiPartOutputFile file(ok.c_str(), headers.data(), int(headers.size()));
+    std::vector<float> px(6, 0.75f);
+    for (int part = 0; part < 2; ++part) {
+      Imf::OutputPart out(file, part);
+      Imf::FrameBuffer fb;
+      fb.insert("Y", Imf::Slice(Imf::FLOAT, (char*)px.data(), sizeof(float), 3 * sizeof(float)));
+      out.setFrameBuffer(fb);
+      out.writePixels(2);
+    }
+  }
+  const ImageF g = read_exr_gray(ok);
+  ASSERT_EQ(g.width(), 3);
+  EXPECT_FLOAT_EQ(g.at(2, 1), 0.75f);
 }
 
 TEST(ImageIOFuzzRegressions, AnExrWithoutItsLineOffsetsIsRefusedBeforeThePixelsAreAllocated) {
