@@ -211,8 +211,19 @@ void check_exr_header(const std::string& b, const std::string& where, int channe
     if (name == "dataWindow" && size == 16) {
       int32_t box[4];  // xmin, ymin, xmax, ymax
       std::memcpy(box, b.data() + pos, sizeof box);
-      check_image_size(where, (long long)box[2] - box[0] + 1, (long long)box[3] - box[1] + 1,
-                       channels, int(sizeof(float)), "EXR");
+      const long long w = (long long)box[2] - box[0] + 1, h = (long long)box[3] - box[1] + 1;
+      check_image_size(where, w, h, channels, int(sizeof(float)), "EXR");
+      // A decompression bomb: 268 bytes declared 16383753 x 7 pixels, which we would have
+      // allocated (1.8 GB) and zeroed before OpenEXR found no data (found by fuzz/fuzz_exr;
+      // fuzz/regressions/exr/window_larger_than_any_compression.exr). No EXR compression packs
+      // one half-float channel more than ~1000:1 (zlib's limit is 1032:1); 10,000:1 plus 64 MB is
+      // far beyond any real file.
+      const double least = double(w) * double(h) * 2.0;  // one half channel, no header
+      if (least > 1e4 * double(b.size()) + 64e6)
+        fail_at(where,
+                "EXR declares {}x{} pixels but holds only {} bytes; no compression packs that "
+                "much (more than 10,000:1)",
+                w, h, b.size());
     }
     pos += std::size_t(size);
   }

@@ -308,6 +308,20 @@ TEST(ImageIOFuzzRegressions, OnlyPngAndJpegAreDecodedSoATgaBombIsRefusedAtOnce) 
   EXPECT_THROW((void)read_gray_map(f), Error);
 }
 
+TEST(ImageIOFuzzRegressions, AnExrDeclaringMorePixelsThanAnyCompressionCouldHoldIsRefused) {
+  // Before: 268 bytes declaring 16383753 x 7 pixels had 1.8 GB allocated and zeroed (libFuzzer:
+  // out of memory) before OpenEXR found no data.
+  const auto f = test::source_dir() / "fuzz/regressions/exr/window_larger_than_any_compression.exr";
+  try {
+    (void)read_exr_rgba(f);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("EXR declares 16383753x7 pixels but holds only 268 bytes"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ImageIOFuzzRegressions, AMultiPartExrHasEveryHeaderChecked) {
   // Before: multi-part headers were left to OpenEXR; this 177-byte file took 20 s and gigabytes.
   const auto f = test::source_dir() / "fuzz/regressions/exr/multipart_attribute_size.exr";
