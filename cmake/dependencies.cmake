@@ -8,6 +8,7 @@ find_package(tinyobjloader REQUIRED)
 find_package(TinyGLTF REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(OpenEXR 3 REQUIRED)
+find_package(JPEG REQUIRED)  # libjpeg-turbo (libjpeg-dev): JPEG decoding
 find_package(CLI11 2 REQUIRED)
 find_package(fmt REQUIRED)
 find_package(spdlog REQUIRED)

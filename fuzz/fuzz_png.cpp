@@ -1,6 +1,8 @@
-// libFuzzer target: PNG/JPEG through stb (image::read_png_rgba, read_png_gray, read_gray_map).
-// stb_image is compiled into this target instrumented (stb_image_instrumented.c) so libFuzzer sees
-// its coverage; it is the same header the library uses through Debian's libstb.
+// libFuzzer target: PNG through stb and JPEG through libjpeg-turbo (image::read_png_rgba,
+// read_gray_map). stb_image is compiled into this target instrumented (stb_image_instrumented.c)
+// so libFuzzer sees its coverage; it is the same header the library uses through Debian's libstb.
+// libjpeg-turbo is Debian's shared library, not instrumented: for JPEG inputs coverage counts
+// Follicle's code only.
 #include "follicle/image/image_io.hpp"
 #include "fuzz_common.hpp"
 

@@ -3,7 +3,7 @@
 set -euo pipefail
 PKGS=(
   cmake ninja-build pkg-config g++ clang-format
-  libeigen3-dev libembree-dev libtbb-dev libstb-dev libtinyobjloader-dev libtinygltf-dev
+  libeigen3-dev libembree-dev libtbb-dev libstb-dev libjpeg-dev libtinyobjloader-dev libtinygltf-dev
   nlohmann-json3-dev libopenexr-dev libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libegl-dev libopengl-dev libgl1-mesa-dri libglfw3-dev libimgui-dev

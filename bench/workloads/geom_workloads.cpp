@@ -1,8 +1,13 @@
 // Geometry workloads: mesh load, closest-point queries on the default head, neighbour search.
+#include <fmt/format.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/rng.hpp"
 #include "follicle/geom/grid.hpp"
@@ -39,6 +44,89 @@ class MeshLoad : public WorkloadInstance {
 
  private:
   fs::path m_path;
+  std::size_t m_faces = 0;
+};
+
+// A large scan-sized mesh (issue 21: "a 1M-triangle mesh loads in under 2 s"): a latitude-
+// longitude sphere of about `triangles` triangles written once, untimed, into a temporary folder
+// in one of the formats users bring scans in; each iteration loads it.
+class LargeMeshLoad : public WorkloadInstance {
+ public:
+  LargeMeshLoad(std::size_t triangles, int format) {
+    const int n = int(std::ceil(std::sqrt(double(triangles) / 2.0))) + 1;
+    geom::TriMesh m;
+    for (int i = 0; i < n; ++i) {
+      const double th = kPi * (i + 0.5) / n;
+      for (int j = 0; j < n; ++j) {
+        const double ph = 2 * kPi * j / (n - 1);
+        m.positions.emplace_back(0.1 * std::sin(th) * std::cos(ph), 0.1 * std::cos(th),
+                                 0.1 * std::sin(th) * std::sin(ph));
+      }
+    }
+    for (int i = 0; i + 1 < n; ++i)
+      for (int j = 0; j + 1 < n; ++j) {
+        const int a = i * n + j, b = a + 1, c = a + n, d = c + 1;
+        m.faces.emplace_back(a, c, b);
+        m.faces.emplace_back(b, c, d);
+      }
+    m_dir = fs::temp_directory_path() / fmt::format("follicle-mesh-load-{}-{}", ::getpid(),
+                                                    reinterpret_cast<std::uintptr_t>(this));
+    fs::create_directories(m_dir);
+    switch (format) {
+      case 0:
+        m_path = m_dir / "mesh.obj";
+        save_mesh(m, m_path, LengthUnit::mm);
+        break;
+      case 1:
+        m_path = m_dir / "mesh.ply";
+        save_mesh(m, m_path, LengthUnit::mm);
+        break;
+      case 2:
+        m_path = m_dir / "mesh.ply";
+        save_mesh(m, m_path, LengthUnit::mm, true);
+        break;
+      case 3: {  // one strip per ring of quads, -1 between them
+        std::string out = fmt::format(
+            "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\n"
+            "property float y\nproperty float z\nelement tristrips 1\nproperty list int int "
+            "vertex_indices\nend_header\n",
+            m.positions.size());
+        auto put = [&](auto v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); };
+        for (const Vec3& p : m.positions)
+          for (int k = 0; k < 3; ++k) put(float(p[k] * 1000.0));
+        put(int32_t((n - 1) * (2 * n + 1) - 1));
+        for (int i = 0; i + 1 < n; ++i) {
+          if (i) put(int32_t(-1));
+          for (int j = 0; j < n; ++j) {
+            put(int32_t(i * n + j));
+            put(int32_t((i + 1) * n + j));
+          }
+        }
+        m_path = m_dir / "mesh.ply";
+        write_file_atomically(m_path, out);
+        break;
+      }
+      default:
+        fail(
+            "size 'format' = {} is not one of 0 (OBJ), 1 (binary PLY), 2 (ASCII PLY), "
+            "3 (PLY triangle strips)",
+            format);
+    }
+    m_faces = m.num_faces();
+  }
+  ~LargeMeshLoad() override {
+    std::error_code ec;
+    fs::remove_all(m_dir, ec);
+  }
+  void run_once() override {
+    const geom::TriMesh m = geom::load_mesh(m_path, LengthUnit::mm);
+    if (m.num_faces() != m_faces)
+      fail("large-mesh-load read {} triangles back, wrote {}", m.num_faces(), m_faces);
+  }
+  double items_per_iter() const override { return double(m_faces); }
+
+ private:
+  fs::path m_dir, m_path;
   std::size_t m_faces = 0;
 };
 
@@ -105,6 +193,21 @@ void add_geom_workloads(std::vector<Workload>& out) {
                  "meshes/s",
                  [](const Context&, const Sizes&) {
                    return std::unique_ptr<WorkloadInstance>(new MeshLoad());
+                 }});
+  out.push_back({"large-mesh-load",
+                 "load a scan-sized latitude-longitude sphere of ~`triangles` triangles in mm; "
+                 "format 0 = OBJ, 1 = binary PLY, 2 = ASCII PLY, 3 = binary PLY triangle strips",
+                 {{"triangles", 1e6}, {"format", 0}},
+                 "triangles/s",
+                 [](const Context&, const Sizes& s) {
+                   const std::size_t t = size_of(s, "triangles", 2);
+                   const double f = s.at("format");
+                   if (!(f >= 0 && f <= 3 && f == std::floor(f)))
+                     fail(
+                         "size 'format' = {} is not one of 0 (OBJ), 1 (binary PLY), 2 (ASCII "
+                         "PLY), 3 (PLY triangle strips)",
+                         f);
+                   return std::unique_ptr<WorkloadInstance>(new LargeMeshLoad(t, int(f)));
                  }});
   out.push_back({"closest-point",
                  "closest surface point on the default head (Embree) for random points around it",

@@ -30,5 +30,14 @@ PY
   "$FOLLICLE" bench "$W" --size no_such_key=3 2>"$TMP/err" >/dev/null
   [ $? = 1 ] && grep -q "has no size 'no_such_key'" "$TMP/err" || { fail "unknown size key"; cat "$TMP/err"; }
 fi
+# large-mesh-load writes its mesh in each format, reads it back and checks the triangle count;
+# a small size keeps this quick. Its temporary folder is removed afterwards.
+for F in 0 1 2 3; do
+  "$FOLLICLE" bench large-mesh-load --size triangles=2000 --size format=$F --min-seconds 0 -q \
+    >"$TMP/run" 2>"$TMP/err" || { fail "large-mesh-load format $F"; cat "$TMP/err"; }
+done
+ls -d "${TMPDIR:-/tmp}"/follicle-mesh-load-* 2>/dev/null && fail "large-mesh-load left its folder"
+"$FOLLICLE" bench large-mesh-load --size format=4 --min-seconds 0 2>"$TMP/err" >/dev/null
+[ $? = 1 ] && grep -q "size 'format' = 4 is not one of" "$TMP/err" || { fail "bad format"; cat "$TMP/err"; }
 [ "$fails" = 0 ] || { echo "$fails failure(s)"; exit 1; }
 echo "bench ok"

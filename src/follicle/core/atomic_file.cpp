@@ -119,11 +119,30 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 }
 
 std::string read_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (std::filesystem::is_directory(st)) fail_at(path.string(), "is a directory, not a file");
   std::ifstream f(path, std::ios::binary);
-  if (!f) fail_at(path.string(), "cannot open file for reading");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
+  if (!f) fail_at(path.string(), "cannot open file for reading: {}", std::strerror(errno));
+  // One read into a string sized from the file's length: `ss << f.rdbuf()` through a
+  // stringstream copied every byte twice and grew its buffer step by step (39% of loading a
+  // 1M-triangle OBJ). Files without a length (pipes; /proc reports 0) are read in chunks, and
+  // so is whatever a file grew by since its size was taken.
+  std::string out;
+  if (std::filesystem::is_regular_file(st)) {
+    const auto len = std::filesystem::file_size(path, ec);
+    if (!ec && len > 0) {
+      out.resize(std::size_t(len));
+      f.read(out.data(), std::streamsize(len));
+      out.resize(std::size_t(f.gcount()));
+      if (f.bad()) fail_at(path.string(), "read failed: {}", std::strerror(errno));
+      f.clear();
+    }
+  }
+  char buf[65536];
+  while (f.read(buf, sizeof buf) || f.gcount() > 0) out.append(buf, std::size_t(f.gcount()));
+  if (f.bad()) fail_at(path.string(), "read failed: {}", std::strerror(errno));
+  return out;
 }
 
 }  // namespace follicle

@@ -21,6 +21,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 #include "follicle/core/atomic_file.hpp"
 #include "follicle/core/error.hpp"
@@ -385,7 +386,11 @@ class PlyReader {
             PlyFormat fmt)
       : m_path(path), m_data(data), m_pos(pos), m_line(line), m_fmt(fmt) {}
 
-  double read(PlyType t, const std::string& what) {
+  // `what` names the value in an error message: a string, or a callable returning one, called
+  // only when the read fails (formatting a description for every value read took most of the
+  // time of loading a large binary PLY).
+  template <class What>
+  double read(PlyType t, const What& what) {
     if (m_fmt == PlyFormat::ascii) return read_ascii(t, what);
     return read_binary(t, what);
   }
@@ -397,7 +402,16 @@ class PlyReader {
   PlyFormat format() const { return m_fmt; }
 
  private:
-  double read_ascii(PlyType t, const std::string& what) {
+  template <class What>
+  static std::string describe(const What& what) {
+    if constexpr (std::is_invocable_v<const What&>)
+      return std::string(what());
+    else
+      return std::string(what);
+  }
+
+  template <class What>
+  double read_ascii(PlyType t, const What& what) {
     // skip whitespace, counting lines
     while (m_pos < m_data.size()) {
       const char c = m_data[m_pos];
@@ -412,7 +426,7 @@ class PlyReader {
     }
     if (m_pos >= m_data.size())
       fail_at(at_line(m_path, m_line), "unexpected end of file while reading {} (truncated?)",
-              what);
+              describe(what));
     std::size_t e = m_pos;
     while (e < m_data.size() && !std::isspace(static_cast<unsigned char>(m_data[e]))) ++e;
     std::string_view tok(m_data.data() + m_pos, e - m_pos);
@@ -420,21 +434,22 @@ class PlyReader {
     double d;
     if (t == PlyType::f32 || t == PlyType::f64) {
       if (!parse_double(tok, d))
-        fail_at(at_line(m_path, m_line), "{}: '{}' is not a number", what, tok);
+        fail_at(at_line(m_path, m_line), "{}: '{}' is not a number", describe(what), tok);
     } else {
       long long i;
       if (!parse_int(tok, i))
-        fail_at(at_line(m_path, m_line), "{}: '{}' is not an integer", what, tok);
+        fail_at(at_line(m_path, m_line), "{}: '{}' is not an integer", describe(what), tok);
       d = double(i);
     }
     return d;
   }
 
-  double read_binary(PlyType t, const std::string& what) {
+  template <class What>
+  double read_binary(PlyType t, const What& what) {
     const std::size_t n = ply_size(t);
     if (m_pos + n > m_data.size())
       fail_at(fmt::format("{} (byte {})", m_path.string(), m_pos),
-              "unexpected end of file while reading {} (truncated?)", what);
+              "unexpected end of file while reading {} (truncated?)", describe(what));
     unsigned char b[8];
     std::memcpy(b, m_data.data() + m_pos, n);
     m_pos += n;
@@ -484,6 +499,95 @@ class PlyReader {
   std::size_t m_line;
   PlyFormat m_fmt;
 };
+
+// Appends the triangles of the strip poly[start..]: triangle k is (v[k], v[k+1], v[k+2]), every
+// odd one reversed to keep the strip's winding; triangles with a repeated vertex are dropped
+// (strips are stitched with them).
+void add_strip(const std::vector<int>& poly, std::size_t start, std::vector<Vec3i>& faces) {
+  for (std::size_t k = start; k + 2 < poly.size(); ++k) {
+    const int a = poly[k], b = poly[k + 1], c = poly[k + 2];
+    if (a == b || b == c || a == c) continue;
+    if ((k - start) % 2 == 0)
+      faces.emplace_back(a, b, c);
+    else
+      faces.emplace_back(b, a, c);
+  }
+}
+
+// Cuts one planar-ish polygon into triangles with its winding. Triangles pass through; a quad is
+// split along the diagonal that keeps both halves facing the quad's (Newell) normal, which is
+// right for convex and concave quads; an n-gon of up to 64 vertices is ear-clipped in the plane
+// of its Newell normal (O(n^2), as tinyobjloader does for OBJ; written here because no Debian
+// package offers polygon triangulation for C++ and tinyobjloader's is internal); larger polygons
+// (scanner hole fills) and those with no ear left (self-intersecting) fall back to a fan.
+void triangulate_polygon(const std::vector<Vec3>& pos, const std::vector<int>& poly,
+                         std::vector<Vec3i>& faces) {
+  const std::size_t n = poly.size();
+  if (n == 3) {
+    faces.emplace_back(poly[0], poly[1], poly[2]);
+    return;
+  }
+  auto fan = [&](const std::vector<int>& ring) {
+    for (std::size_t j = 1; j + 1 < ring.size(); ++j)
+      faces.emplace_back(ring[0], ring[j], ring[j + 1]);
+  };
+  Vec3 normal = Vec3::Zero();  // Newell's method
+  for (std::size_t j = 0; j < n; ++j) {
+    const Vec3& a = pos[std::size_t(poly[j])];
+    const Vec3& b = pos[std::size_t(poly[(j + 1) % n])];
+    normal += Vec3((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()),
+                   (a.x() - b.x()) * (a.y() + b.y()));
+  }
+  if (!(normal.squaredNorm() > 0) || n > 64) return fan(poly);
+  auto facing = [&](int a, int b, int c) {
+    const Vec3& pa = pos[std::size_t(a)];
+    return (pos[std::size_t(b)] - pa).cross(pos[std::size_t(c)] - pa).dot(normal);
+  };
+  if (n == 4) {
+    const int a = poly[0], b = poly[1], c = poly[2], d = poly[3];
+    if (facing(a, b, c) > 0 && facing(a, c, d) > 0) {
+      faces.emplace_back(a, b, c);
+      faces.emplace_back(a, c, d);
+    } else {
+      faces.emplace_back(b, c, d);
+      faces.emplace_back(b, d, a);
+    }
+    return;
+  }
+  // Project onto the plane: drop the normal's largest axis; keep counter-clockwise orientation.
+  int drop = 0;
+  normal.cwiseAbs().maxCoeff(&drop);
+  const int ax = (drop + 1) % 3, ay = (drop + 2) % 3;
+  const double flip = normal[drop] < 0 ? -1.0 : 1.0;
+  auto p2 = [&](int v) {
+    const Vec3& p = pos[std::size_t(v)];
+    return Vec2(p[ax], flip * p[ay]);
+  };
+  auto cross2 = [](const Vec2& o, const Vec2& a, const Vec2& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<int> ring = poly;
+  while (ring.size() > 3) {
+    bool cut = false;
+    for (std::size_t j = 0; j < ring.size() && !cut; ++j) {
+      const std::size_t jp = (j + ring.size() - 1) % ring.size(), jn = (j + 1) % ring.size();
+      const Vec2 a = p2(ring[jp]), b = p2(ring[j]), c = p2(ring[jn]);
+      if (cross2(a, b, c) <= 0) continue;  // reflex or flat corner
+      bool empty = true;
+      for (std::size_t q = 0; q < ring.size() && empty; ++q) {
+        if (q == jp || q == j || q == jn) continue;
+        const Vec2 p = p2(ring[q]);
+        empty = !(cross2(a, b, p) >= 0 && cross2(b, c, p) >= 0 && cross2(c, a, p) >= 0);
+      }
+      if (!empty) continue;
+      faces.emplace_back(ring[jp], ring[j], ring[jn]);
+      ring.erase(ring.begin() + std::ptrdiff_t(j));
+      cut = true;
+    }
+    if (!cut) return fan(ring);
+  }
+  faces.emplace_back(ring[0], ring[1], ring[2]);
+}
 
 TriMesh load_ply(const fs::path& path) {
   const std::string data = read_file(path);
@@ -619,7 +723,8 @@ TriMesh load_ply(const fs::path& path) {
             if (c < 0) fail_at(rd.where(), "negative list count {}", c);
             for (long long j = 0; j < (long long)c; ++j) rd.read(p.type, "vertex list item");
           } else {
-            vals[k] = rd.read(p.type, fmt::format("vertex {} property '{}'", i, p.name));
+            vals[k] =
+                rd.read(p.type, [&] { return fmt::format("vertex {} property '{}'", i, p.name); });
             if (!std::isfinite(vals[k]))
               fail_at(rd.where(), "vertex {} property '{}' is not finite ({})", i, p.name, vals[k]);
           }
@@ -630,14 +735,20 @@ TriMesh load_ply(const fs::path& path) {
               Vec3(vals[std::size_t(inx)], vals[std::size_t(iny)], vals[std::size_t(inz)]);
         if (uvs) m.uvs[i] = Vec2(vals[std::size_t(iu)], vals[std::size_t(iv)]);
       }
-    } else if (el.name == "face") {
-      if (!have_vertex) fail_at(file, "face element before the vertex element");
+    } else if (el.name == "face" || el.name == "tristrips") {
+      // `face`: one polygon per item (triangles, quads and n-gons, cut by triangulate_polygon).
+      // `tristrips` (Stanford's strip element, e.g. the scanned models of the Stanford
+      // repository): each list is one or more triangle strips separated by -1; triangle k of a
+      // strip is (v[k], v[k+1], v[k+2]) with every second one reversed so that all keep the
+      // strip's winding; triangles with a repeated vertex (the usual strip stitches) are dropped.
+      const bool strips = el.name == "tristrips";
+      if (!have_vertex) fail_at(file, "{} element before the vertex element", el.name);
       int ilist = -1;
       for (std::size_t k = 0; k < el.props.size(); ++k)
         if (el.props[k].is_list &&
             (el.props[k].name == "vertex_indices" || el.props[k].name == "vertex_index"))
           ilist = int(k);
-      if (ilist < 0) fail_at(file, "face element lacks a 'vertex_indices' list property");
+      if (ilist < 0) fail_at(file, "{} element lacks a 'vertex_indices' list property", el.name);
       std::vector<int> poly;
       for (std::size_t i = 0; i < el.count; ++i) {
         for (std::size_t k = 0; k < el.props.size(); ++k) {
@@ -646,23 +757,37 @@ TriMesh load_ply(const fs::path& path) {
             rd.read(p.type, "face property");
             continue;
           }
-          const double c = rd.read(p.count_type, fmt::format("face {} index count", i));
-          if (c < 0) fail_at(rd.where(), "face {} has negative index count {}", i, c);
-          poly.clear();
-          for (long long j = 0; j < (long long)c; ++j) {
-            const double idx = rd.read(p.type, fmt::format("face {} index", i));
-            if (int(k) == ilist) {
-              if (!(idx >= 0 && idx < double(nv)))
-                fail_at(rd.where(), "face {} references vertex {}, expected an index in [0, {})", i,
-                        idx, nv);
-              poly.push_back(int(idx));
-            }
+          const double c = rd.read(p.count_type, [&] {
+            return fmt::format("{} {} index count", strips ? "strip list" : "face", i);
+          });
+          if (c < 0) fail_at(rd.where(), "{} {} has negative index count {}", el.name, i, c);
+          if (int(k) != ilist) {
+            for (long long j = 0; j < (long long)c; ++j) rd.read(p.type, "list item");
+            continue;
           }
-          if (int(k) == ilist) {
+          poly.clear();
+          std::size_t strip_start = 0;
+          for (long long j = 0; j < (long long)c; ++j) {
+            const double idx = rd.read(p.type, [&] {
+              return fmt::format("{} {} index", strips ? "strip list" : "face", i);
+            });
+            if (strips && idx == -1) {
+              add_strip(poly, strip_start, m.faces);
+              strip_start = poly.size();
+              continue;
+            }
+            if (!(idx >= 0 && idx < double(nv)))
+              fail_at(rd.where(), "{} {} references vertex {}, expected an index in [0, {}){}",
+                      strips ? "strip list" : "face", i, idx, nv,
+                      strips ? " or -1 between strips" : "");
+            poly.push_back(int(idx));
+          }
+          if (strips) {
+            add_strip(poly, strip_start, m.faces);
+          } else {
             if (poly.size() < 3)
               fail_at(rd.where(), "face {} has {} vertices, expected at least 3", i, poly.size());
-            for (std::size_t j = 1; j + 1 < poly.size(); ++j)
-              m.faces.emplace_back(poly[0], poly[j], poly[j + 1]);
+            triangulate_polygon(m.positions, poly, m.faces);
           }
         }
       }
@@ -670,12 +795,13 @@ TriMesh load_ply(const fs::path& path) {
       for (std::size_t i = 0; i < el.count; ++i)
         for (const PlyProperty& p : el.props) {
           if (p.is_list) {
-            const double c = rd.read(p.count_type, fmt::format("'{}' list count", el.name));
+            const double c =
+                rd.read(p.count_type, [&] { return fmt::format("'{}' list count", el.name); });
             if (c < 0) fail_at(rd.where(), "negative list count {}", c);
             for (long long j = 0; j < (long long)c; ++j)
-              rd.read(p.type, fmt::format("'{}' list item", el.name));
+              rd.read(p.type, [&] { return fmt::format("'{}' list item", el.name); });
           } else {
-            rd.read(p.type, fmt::format("'{}' property", el.name));
+            rd.read(p.type, [&] { return fmt::format("'{}' property", el.name); });
           }
         }
     }

@@ -9,7 +9,9 @@
 
 namespace follicle::geom {
 
-/// Reads a mesh; polygons are fan-triangulated. Throws follicle::Error naming the file (and line
+/// Reads a mesh. Polygons are cut into triangles along their inside (ear clipping in their
+/// plane, up to 64 vertices; larger ones as fans); PLY triangle strips (`tristrips`, -1 between
+/// strips) are read too. Throws follicle::Error naming the file (and line
 /// where the format has lines) on malformed input: truncation, NaN/Inf, out-of-range indices,
 /// empty files, unknown extension.
 TriMesh load_mesh(const std::filesystem::path& path, LengthUnit unit);

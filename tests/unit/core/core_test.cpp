@@ -163,6 +163,21 @@ TEST(AtomicFile, WritesWholeFileOrNothing) {
   EXPECT_THROW(read_file(dir / "missing.txt"), Error);
 }
 
+TEST(AtomicFile, ReadFileReturnsEveryByteOfLargeAndUnsizedFiles) {
+  auto dir = test::scratch_dir("read_file");
+  std::string big(3 * 65536 + 17, '\0');
+  for (std::size_t i = 0; i < big.size(); ++i) big[i] = char((i * 131 + i / 7) & 0xFF);
+  write_file_atomically(dir / "big.bin", big);
+  EXPECT_EQ(read_file(dir / "big.bin"), big);
+  write_file_atomically(dir / "empty.bin", "");
+  EXPECT_EQ(read_file(dir / "empty.bin"), "");
+  // Files in /proc report a size of 0 but have content: read in chunks to the end.
+  const std::string status = read_file("/proc/self/status");
+  EXPECT_NE(status.find("Name:"), std::string::npos);
+  EXPECT_NE(status.find("VmRSS"), std::string::npos);
+  EXPECT_THROW(read_file(dir), Error);  // a folder
+}
+
 TEST(Cpu, Avx2CheckAgreesWithTheKernelsCpuFlags) {
   const bool a = follicle::cpu_has_avx2();
   EXPECT_EQ(a, follicle::cpu_has_avx2());  // evaluated once, stable

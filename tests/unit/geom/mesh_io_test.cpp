@@ -1,8 +1,11 @@
 // Mesh I/O: round trips in every format, units, the shipped head, malformed inputs.
 #include "follicle/geom/mesh_io.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -154,6 +157,163 @@ TEST(MeshIO, PlyBigEndianAndQuadsAndExtraElements) {
   ASSERT_EQ(m.num_faces(), 2u);  // quad fan-triangulated
   EXPECT_EQ(m.positions[2], Vec3(2, 1, 0.5));
   EXPECT_NEAR(m.face_area(0) + m.face_area(1), 2.0, 1e-12);
+}
+
+// Sum of face areas and the number of faces whose normal points against `n`.
+std::pair<double, int> area_and_flipped(const TriMesh& m, const Vec3& n) {
+  double area = 0;
+  int flipped = 0;
+  for (std::size_t f = 0; f < m.num_faces(); ++f) {
+    area += m.face_area(f);
+    flipped += m.face_normal(f).dot(n) < 0.99;
+  }
+  return {area, flipped};
+}
+
+std::string ply_ascii_header(std::size_t nv, const std::string& face_element) {
+  return "ply\nformat ascii 1.0\nelement vertex " + std::to_string(nv) +
+         "\nproperty float x\nproperty float y\nproperty float z\n" + face_element + "end_header\n";
+}
+
+TEST(MeshIO, PlyTriangleStripsGiveTheSameSurfaceAsTheirTriangles) {
+  // A 4 x 3 vertex grid in the z = 0 plane as two strips (one per row of quads) separated by -1,
+  // and the same grid as explicit triangles. Strips alternate winding; all faces must face +z.
+  const auto dir = test::scratch_dir("ply-strips");
+  const int nx = 4, ny = 3;
+  std::string verts;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) verts += fmt::format("{} {} 0\n", i, j);
+  std::string strip, tris;
+  int nstrip = 0, ntri = 0;
+  for (int j = 0; j + 1 < ny; ++j) {
+    if (j) {
+      strip += " -1";
+      ++nstrip;
+    }
+    for (int i = 0; i < nx; ++i) {
+      strip += fmt::format(" {} {}", (j + 1) * nx + i, j * nx + i);
+      nstrip += 2;
+    }
+    for (int i = 0; i + 1 < nx; ++i) {
+      const int a = j * nx + i, b = a + 1, c = a + nx, d = c + 1;
+      tris += fmt::format("3 {} {} {}\n3 {} {} {}\n", a, b, d, a, d, c);
+      ntri += 2;
+    }
+  }
+  write_text(
+      dir / "strips.ply",
+      ply_ascii_header(nx * ny, "element tristrips 1\nproperty list int int vertex_indices\n") +
+          verts + std::to_string(nstrip) + strip + "\n");
+  write_text(dir / "tris.ply",
+             ply_ascii_header(nx * ny, fmt::format("element face {}\nproperty list uchar int "
+                                                   "vertex_indices\n",
+                                                   ntri)) +
+                 verts + tris);
+  const TriMesh s = load_mesh(dir / "strips.ply", LengthUnit::m);
+  const TriMesh t = load_mesh(dir / "tris.ply", LengthUnit::m);
+  ASSERT_EQ(s.num_faces(), t.num_faces());
+  ASSERT_EQ(s.num_faces(), std::size_t(2 * (nx - 1) * (ny - 1)));
+  const auto [sa, sflip] = area_and_flipped(s, Vec3::UnitZ());
+  EXPECT_NEAR(sa, double((nx - 1) * (ny - 1)), 1e-12);
+  EXPECT_EQ(sflip, 0);
+  // Same triangles as sets of vertices.
+  auto sorted = [](const TriMesh& m) {
+    std::vector<std::array<int, 3>> out;
+    for (const auto& f : m.faces) {
+      std::array<int, 3> a{f[0], f[1], f[2]};
+      std::sort(a.begin(), a.end());
+      out.push_back(a);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(sorted(s), sorted(t));
+
+  // A stitched single strip (repeated vertices between rows) gives the same triangles: the
+  // degenerate stitch triangles are dropped.
+  write_text(
+      dir / "stitched.ply",
+      ply_ascii_header(nx * ny, "element tristrips 1\nproperty list int int vertex_indices\n") +
+          verts + "18 4 0 5 1 6 2 7 3 3 8 8 4 9 5 10 6 11 7\n");
+  const TriMesh st = load_mesh(dir / "stitched.ply", LengthUnit::m);
+  EXPECT_EQ(sorted(st), sorted(t));
+  EXPECT_EQ(area_and_flipped(st, Vec3::UnitZ()).second, 0);
+
+  // An index that is neither a vertex nor the -1 separator is refused with its place.
+  write_text(
+      dir / "bad.ply",
+      ply_ascii_header(nx * ny, "element tristrips 1\nproperty list int int vertex_indices\n") +
+          verts + "4 0 4 -2 5\n");
+  try {
+    (void)load_mesh(dir / "bad.ply", LengthUnit::m);
+    ADD_FAILURE() << "no error for an index of -2";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    for (const char* part :
+         {"bad.ply:", "strip list 0 references vertex -2", "or -1 between strips"})
+      EXPECT_NE(msg.find(part), std::string::npos) << msg;
+  }
+}
+
+TEST(MeshIO, PlyPolygonsAreCutAlongTheirInsideIncludingConcaveOnes) {
+  const auto dir = test::scratch_dir("ply-polygons");
+  auto load_polygon = [&](const std::vector<Vec2>& pts, const std::string& name) {
+    std::string body;
+    for (const auto& p : pts) body += fmt::format("{} {} 0\n", p.x(), p.y());
+    body += fmt::format("{}", pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) body += fmt::format(" {}", i);
+    body += "\n";
+    write_text(
+        dir / name,
+        ply_ascii_header(pts.size(), "element face 1\nproperty list uchar int vertex_indices\n") +
+            body);
+    return load_mesh(dir / name, LengthUnit::m);
+  };
+  auto shoelace = [](const std::vector<Vec2>& p) {
+    double a = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Vec2& u = p[i];
+      const Vec2& v = p[(i + 1) % p.size()];
+      a += u.x() * v.y() - v.x() * u.y();
+    }
+    return 0.5 * a;
+  };
+  // A concave quad (an arrow head) whose reflex corner is the last vertex: a fan from the first
+  // would cut along a diagonal outside the polygon and flip one triangle.
+  const std::vector<Vec2> arrow = {{0, 0}, {2, 1}, {0, 2}, {0.5, 1}};
+  // An L-shaped hexagon, a concave octagon (a "U"), and a convex 10-gon.
+  const std::vector<Vec2> ell = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  const std::vector<Vec2> u = {{0, 0}, {3, 0}, {3, 2}, {2, 2}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  std::vector<Vec2> round;
+  for (int k = 0; k < 10; ++k)
+    round.emplace_back(std::cos(0.2 * M_PI * k), std::sin(0.2 * M_PI * k));
+  for (const auto& [poly, name] : {std::pair{arrow, "arrow.ply"}, std::pair{ell, "ell.ply"},
+                                   std::pair{u, "u.ply"}, std::pair{round, "round.ply"}}) {
+    const double want = std::abs(shoelace(poly));
+    for (const bool reversed : {false, true}) {
+      auto p = poly;
+      if (reversed) std::reverse(p.begin(), p.end());
+      const TriMesh m = load_polygon(p, std::string(reversed ? "r" : "") + name);
+      EXPECT_EQ(m.num_faces(), p.size() - 2) << name;
+      const auto [area, flipped] =
+          area_and_flipped(m, reversed ? Vec3(-Vec3::UnitZ()) : Vec3(Vec3::UnitZ()));
+      EXPECT_NEAR(area, want, 1e-9) << name << (reversed ? " reversed" : "");
+      EXPECT_EQ(flipped, 0) << name << (reversed ? " reversed" : "");
+    }
+  }
+  // The same polygons standing in the y-z plane (the projection follows the polygon's normal).
+  {
+    std::string body;
+    for (const auto& p : u) body += fmt::format("0 {} {}\n", p.x(), p.y());
+    body += "8 0 1 2 3 4 5 6 7\n";
+    write_text(
+        dir / "u_yz.ply",
+        ply_ascii_header(8, "element face 1\nproperty list uchar int vertex_indices\n") + body);
+    const TriMesh m = load_mesh(dir / "u_yz.ply", LengthUnit::m);
+    const auto [area, flipped] = area_and_flipped(m, Vec3::UnitX());
+    EXPECT_NEAR(area, 5.0, 1e-9);
+    EXPECT_EQ(flipped, 0);
+  }
 }
 
 class GltfRoundTrip : public ::testing::TestWithParam<std::string> {};

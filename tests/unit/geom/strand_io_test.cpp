@@ -528,6 +528,18 @@ TEST(StrandIo, ObjPolylinesReader) {
   write_file_atomically(dir / "lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n");
   EXPECT_TRUE(is_strand_file(dir / "lines.obj"));
   EXPECT_EQ(load_strands(dir / "lines.obj", LengthUnit::m).num_points(), 2u);
+  // Only the first word of a logical line counts: an "f" continuing a line, in a comment or in
+  // a name is no face; an indented one, one right before a continuation, or CRLF ends are.
+  write_file_atomically(dir / "cont.obj", "v 0 0 0\nv 1 0 0\nl 1 \\\nf\ng f\n# f 1 2 3\nl 2 1\n");
+  EXPECT_TRUE(is_strand_file(dir / "cont.obj"));
+  write_file_atomically(dir / "indented.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n\t f 1 2 3\n");
+  EXPECT_FALSE(is_strand_file(dir / "indented.obj"));
+  write_file_atomically(dir / "fcont.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nf\\\n 1 2 3\n");
+  EXPECT_FALSE(is_strand_file(dir / "fcont.obj"));
+  write_file_atomically(dir / "crlf.obj", "v 0 0 0\r\nv 1 0 0\r\nl 1 2\r\n");
+  EXPECT_TRUE(is_strand_file(dir / "crlf.obj"));
+  write_file_atomically(dir / "nolines.obj", "v 0 0 0\nv 1 0 0\n");
+  EXPECT_FALSE(is_strand_file(dir / "nolines.obj"));
 }
 
 TEST(StrandIo, LyingAndTruncatedFilesFailWithWhereAndWhat) {
