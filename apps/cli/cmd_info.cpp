@@ -23,14 +23,41 @@ std::string lower_ext(const std::string& path) {
   return ext;
 }
 
-void mesh_info(const std::string& path, LengthUnit unit) {
+// How the unit was chosen: OBJ, PLY, .hair and .tfx do not record one.
+std::string unit_source(bool given) {
+  return given ? "as declared with --units"
+               : "assumed: no --units given, and this format does not record a unit";
+}
+
+// A head is 0.2-0.3 m across, a bust up to 0.6 m, a hand about 0.2 m: a mesh far outside
+// 5 cm - 3 m in the declared unit was probably written in another one. Names the unit that makes
+// it body-sized (a 34 m "head" from a file in cm read as m is the usual case).
+void size_note(double diag_m, LengthUnit unit, bool given) {
+  if (diag_m >= 0.05 && diag_m <= 3.0) return;
+  std::string hint;
+  for (LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::dm, LengthUnit::m}) {
+    const double d = diag_m / unit_to_metres(unit) * unit_to_metres(u);
+    if (u != unit && d >= 0.1 && d <= 1.0) {
+      hint = fmt::format("; with --units {} it is {:.2f} m across, the size of a head or bust",
+                         to_string(u), d);
+      break;
+    }
+  }
+  fmt::print("note: {:.3g} m across in {} ({}) is not the size of a head, bust or hand{}\n", diag_m,
+             to_string(unit), given ? "declared" : "assumed", hint);
+}
+
+void mesh_info(const std::string& path, LengthUnit unit, bool unit_given) {
   const auto mesh = geom::load_mesh(path, unit);
   const double k = 1.0 / unit_to_metres(unit);
   const auto box = mesh.bounds();
   double area = 0.0;
   for (std::size_t f = 0; f < mesh.num_faces(); ++f) area += mesh.face_area(f);
   fmt::print("mesh: {}\n", path);
-  fmt::print("units: {} (as declared with --units)\n", to_string(unit));
+  const std::string file_ext = lower_ext(path);
+  const bool gltf = file_ext == ".gltf" || file_ext == ".glb";
+  fmt::print("units: {} ({})\n", to_string(unit),
+             gltf && !unit_given ? "metres by the glTF specification" : unit_source(unit_given));
   fmt::print("vertices: {}\n", mesh.num_vertices());
   fmt::print("faces: {}\n", mesh.num_faces());
   fmt::print("uvs: {}\n", mesh.has_uvs() ? fmt::format("yes ({})", mesh.uvs.size()) : "no");
@@ -44,6 +71,7 @@ void mesh_info(const std::string& path, LengthUnit unit) {
     fmt::print("extent: [{:.6g}, {:.6g}, {:.6g}] {}\n", ext.x(), ext.y(), ext.z(), to_string(unit));
   }
   fmt::print("surface area: {:.6g} m^2\n", area);
+  if (mesh.num_vertices() > 0) size_note((box.max() - box.min()).norm(), unit, unit_given);
 }
 
 // "cm", or "0.0254 m" for a USD metersPerUnit that is not one of ours.
@@ -55,7 +83,7 @@ std::string unit_label(double metres_per_unit) {
 }
 
 // Strand files: lengths and bounds in the file's unit (USD: its metersPerUnit, else --units).
-void hair_info(const std::string& path, LengthUnit unit) {
+void hair_info(const std::string& path, LengthUnit unit, bool unit_given) {
   geom::StrandFileInfo info;
   const auto s = geom::load_strands(path, unit, &info);
   const double k = 1.0 / info.metres_per_unit;
@@ -66,7 +94,7 @@ void hair_info(const std::string& path, LengthUnit unit) {
     fmt::print("units: {} (metersPerUnit {} from the file; --units is ignored)\n", label,
                info.metres_per_unit);
   else
-    fmt::print("units: {} (as declared with --units)\n", label);
+    fmt::print("units: {} ({})\n", label, unit_source(unit_given));
   fmt::print("strands: {}\n", s.num_strands());
   fmt::print("points: {}\n", s.num_points());
   fmt::print("segments: {}\n",
@@ -110,11 +138,11 @@ int run_info(const GlobalOptions& g, const InfoArgs& a) {
   }
   // An .obj with `l` polylines and no faces holds hair strands; otherwise it is a mesh.
   if (geom::is_strand_file(a.file)) {
-    hair_info(a.file, parse_length_unit(a.units));
+    hair_info(a.file, parse_length_unit(a.units), a.units_given);
     return 0;
   }
   if (ext == ".obj" || ext == ".ply" || ext == ".gltf" || ext == ".glb") {
-    mesh_info(a.file, parse_length_unit(a.units));
+    mesh_info(a.file, parse_length_unit(a.units), a.units_given);
     return 0;
   }
   fail_at(a.file,

@@ -48,7 +48,8 @@ int run_validate(const GlobalOptions& g, const ValidateArgs& a);
 
 struct InfoArgs {
   std::string file;
-  std::string units = "m";  // for mesh files
+  std::string units = "m";   // for mesh files
+  bool units_given = false;  // --units on the command line (else metres are assumed)
 };
 int run_info(const GlobalOptions& g, const InfoArgs& a);
 

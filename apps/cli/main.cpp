@@ -70,8 +70,9 @@ int main(int argc, char** argv) {
                    "scene (.json), mesh (.obj, .ply, .gltf, .glb) or hair (.hair, .tfx, .usda, "
                    ".obj lines)")
       ->required();
-  info->add_option("--units", ia.units, "length unit of a mesh or hair file: mm, cm, dm, m")
-      ->capture_default_str();
+  auto* info_units =
+      info->add_option("--units", ia.units, "length unit of a mesh or hair file: mm, cm, dm, m")
+          ->capture_default_str();
 
   ConvertArgs ca;
   auto* convert = app.add_subcommand(
@@ -192,7 +193,10 @@ int main(int argc, char** argv) {
   try {
     if (*render) return run_render(g, ra);
     if (*validate) return run_validate(g, va);
-    if (*info) return run_info(g, ia);
+    if (*info) {
+      ia.units_given = info_units->count() > 0;
+      return run_info(g, ia);
+    }
     if (*convert) return run_convert(g, ca);
     if (*bench) return run_bench(g, ba);
     if (*docs) return run_docs(g, da);

@@ -12,6 +12,14 @@ grep -q '^faces: [1-9]' "$TMP/info0" || fail "no face count"
 grep -q '^uvs: yes' "$TMP/info0" || fail "head has UVs"
 grep -q '^units: mm' "$TMP/info0" || fail "units not reported"
 grep -q '^bounds max: \[' "$TMP/info0" || fail "no bounds"
+grep -q '^units: mm (as declared with --units)' "$TMP/info0" || fail "declared unit not said"
+grep -q '^note:' "$TMP/info0" && fail "a head in mm declared mm got a size note"
+# Without --units: metres are assumed, and said; the head (in mm) is 250 m across in metres,
+# which the note names with the unit that fits.
+"$FOLLICLE" info "$MESH" >"$TMP/info_nounits" 2>"$TMP/err" || { fail "info without units"; cat "$TMP/err"; }
+grep -q '^units: m (assumed: no --units given' "$TMP/info_nounits" || fail "assumed unit not said: $(grep units "$TMP/info_nounits")"
+grep -q "^note: .* m across in m (assumed) is not the size of a head, bust or hand; with --units mm it is 0\.[0-9][0-9] m across" "$TMP/info_nounits" \
+  || fail "size note: $(grep note "$TMP/info_nounits")"
 
 "$FOLLICLE" info "$ROOT/data/scenes/default.json" >"$TMP/sinfo" 2>"$TMP/err" || { fail "info scene"; cat "$TMP/err"; }
 grep -q '^meshes: 1' "$TMP/sinfo" || fail "scene info: meshes"

@@ -78,6 +78,7 @@ std::string format_count(double count) {
 
 void check_memory(const std::string& where, std::string_view what, double bytes,
                   std::string_view hint, uint64_t available) {
+  if (available == 0 && std::isfinite(bytes) && bytes < kAlwaysAffordableBytes) return;
   if (available == 0) available = available_memory_bytes();
   if (available == 0) return;  // unknown: nothing to compare with
   if (std::isfinite(bytes) && bytes <= double(available)) return;

@@ -24,6 +24,10 @@ std::string format_count(double count);
 /// Throws follicle::Error at `where` when an estimate of `bytes` about to be allocated for `what`
 /// exceeds the available memory: "<what> needs about 12.3 GB but this machine has 7.10 GB
 /// available; <hint>". `available` overrides the system's figure (tests; 0 = ask the system).
+/// Estimates below kAlwaysAffordableBytes return at once without asking the system: the guard
+/// is for allocations that could exhaust a machine, and reading /proc for every small GPU
+/// buffer of every frame cost more than the upload.
+constexpr double kAlwaysAffordableBytes = 16.0 * 1024 * 1024;
 void check_memory(const std::string& where, std::string_view what, double bytes,
                   std::string_view hint, uint64_t available = 0);
 

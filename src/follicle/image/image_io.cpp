@@ -42,7 +42,9 @@ constexpr long long kMaxImagePixels = 1LL << 28;
 void check_image_size(const std::string& where, long long w, long long h, int channels,
                       int bytes_per_channel, const char* format) {
   if (w <= 0 || h <= 0) fail_at(where, "{} image size {}x{} is invalid", format, w, h);
-  if (w * h > kMaxImagePixels)
+  // In double: an EXR window of two 32-bit spans reaches 2^64 pixels, past long long (found by
+  // fuzz/fuzz_exr: signed overflow, fuzz/regressions/exr/window_product_overflow.exr).
+  if (double(w) * double(h) > double(kMaxImagePixels))
     fail_at(where,
             "{} image is {}x{} ({} pixels); Follicle reads images of at most {} pixels "
             "(16384x16384)",

@@ -427,6 +427,19 @@ TEST(ImageIOFuzzRegressions, AnExrDeclaringMorePixelsThanItsCompressionCouldHold
   }
 }
 
+TEST(ImageIOFuzzRegressions, AnExrWindowOfTwoHugeSpansIsRefusedWithoutOverflow) {
+  // Before: the pixel count 3587428055 x 2732673665 was formed in long long (UBSan: signed
+  // integer overflow; in release it wrapped and could pass the limit).
+  const auto f = test::source_dir() / "fuzz/regressions/exr/window_product_overflow.exr";
+  try {
+    (void)read_exr_rgba(f);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("EXR image is 3587428055x2732673665"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ImageIOFuzzRegressions, AnExrChannelListEndingInsideANameIsRefused) {
   // Before: the channel-list check took a channel name left unfinished in the list's last byte
   // for the list's end; OpenEXR read on past the declared size, out of step with the header walk,
