@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
   DocsArgs da;
   auto* docs = app.add_subcommand("docs", "");  // hidden: an empty group hides it from --help
   docs->group("");
-  docs->add_option("topic", da.topic, "scene-format")->required();
+  docs->add_option("topic", da.topic, "scene-format or face-setup")->required();
   docs->add_option("--write", da.write, "markdown file whose generated tables to refresh");
   docs->add_flag("--check", da.check, "fail when the file is out of date (with --write)");
 

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 
+#include "follicle/core/error.hpp"
 #include "follicle/scene/scene.hpp"
+#include "follicle/skin/skin_json.hpp"
 
 namespace follicle::scene {
 
@@ -29,8 +31,10 @@ bool find_block(const std::string& md, const std::string& name, std::size_t& b, 
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> scene_doc_blocks() {
-  const auto rows = doc_rows<Scene>("");
+namespace {
+
+// Rows grouped into blocks by their top-level key ("top" for plain keys).
+std::vector<std::pair<std::string, std::string>> grouped_blocks(const std::vector<DocRow>& rows) {
   std::vector<std::pair<std::string, std::vector<DocRow>>> groups{{"top", {}}};
   for (const auto& r : rows) {
     const auto cut = r.key.find_first_of(".[");
@@ -52,9 +56,21 @@ std::vector<std::pair<std::string, std::string>> scene_doc_blocks() {
   return out;
 }
 
-std::string update_scene_doc(const std::string& markdown) {
+}  // namespace
+
+std::vector<std::string> doc_topics() {
+  return {"scene-format", "face-setup"};
+}
+
+std::vector<std::pair<std::string, std::string>> doc_blocks(const std::string& topic) {
+  if (topic == "scene-format") return grouped_blocks(doc_rows<Scene>(""));
+  if (topic == "face-setup") return grouped_blocks(doc_rows<skin::FaceSetup>(""));
+  fail("unknown docs topic '{}': expected scene-format or face-setup", topic);
+}
+
+std::string update_doc(const std::string& topic, const std::string& markdown) {
   std::string md = markdown;
-  for (const auto& [name, table] : scene_doc_blocks()) {
+  for (const auto& [name, table] : doc_blocks(topic)) {
     std::size_t b = 0, e = 0;
     if (find_block(md, name, b, e)) {
       md.replace(b, e - b, table);
@@ -66,14 +82,26 @@ std::string update_scene_doc(const std::string& markdown) {
   return md;
 }
 
-std::vector<std::string> stale_scene_doc_blocks(const std::string& markdown) {
+std::vector<std::string> stale_doc_blocks(const std::string& topic, const std::string& markdown) {
   std::vector<std::string> out;
-  for (const auto& [name, table] : scene_doc_blocks()) {
+  for (const auto& [name, table] : doc_blocks(topic)) {
     std::size_t b = 0, e = 0;
     if (!find_block(markdown, name, b, e) || markdown.substr(b, e - b) != table)
       out.push_back(name);
   }
   return out;
+}
+
+std::vector<std::pair<std::string, std::string>> scene_doc_blocks() {
+  return doc_blocks("scene-format");
+}
+
+std::string update_scene_doc(const std::string& markdown) {
+  return update_doc("scene-format", markdown);
+}
+
+std::vector<std::string> stale_scene_doc_blocks(const std::string& markdown) {
+  return stale_doc_blocks("scene-format", markdown);
 }
 
 }  // namespace follicle::scene

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <functional>
+#include <nlohmann/json.hpp>
 
 #include "follicle/core/atomic_file.hpp"
+#include "follicle/core/error.hpp"
 #include "follicle/scene/scene.hpp"
 #include "follicle/scene/scene_docs.hpp"
 #include "testing/testing.hpp"
@@ -157,6 +160,43 @@ TEST(SceneDocs, SceneFormatDocIsInSync) {
   // Updating an in-sync doc changes nothing; updating an empty doc adds every block.
   EXPECT_EQ(update_scene_doc(read_file(doc)), read_file(doc));
   EXPECT_TRUE(stale_scene_doc_blocks(update_scene_doc("# x\n")).empty());
+}
+
+TEST(SceneDocs, FaceSetupDocIsInSyncAndCoversEveryKey) {
+  const auto doc = test::source_dir() / "docs" / "face-setup.md";
+  if (const char* u = std::getenv("FOLLICLE_UPDATE_DOCS"); u && *u == '1')
+    write_file_atomically(doc, update_doc("face-setup", read_file(doc)));
+  const auto stale = stale_doc_blocks("face-setup", read_file(doc));
+  std::string names;
+  for (const auto& s : stale) names += s + " ";
+  EXPECT_TRUE(stale.empty()) << "docs/face-setup.md is out of date in blocks: " << names
+                             << "\nrun: follicle docs face-setup --write docs/face-setup.md";
+  std::string all;
+  for (const auto& [name, table] : doc_blocks("face-setup")) all += table;
+  for (const char* key :
+       {"`follicle_face`", "`muscles.linear[].origin`", "`muscles.sphincter[].semi_axis_a`",
+        "`muscles.jaw.pivot`", "`muscles.expressions[].contractions`", "`wrinkles[].p3`",
+        "`wrinkles[].r`"})
+    EXPECT_THAT(all, HasSubstr(key));
+  // Every key the shipped setup uses is documented (comments excepted).
+  const auto shipped = nlohmann::json::parse(
+      read_file(test::source_dir() / "data" / "muscles" / "lee_perry_smith.json"));
+  std::function<void(const nlohmann::json&, const std::string&)> walk =
+      [&](const nlohmann::json& j, const std::string& prefix) {
+        if (j.is_array()) {
+          for (const auto& e : j) walk(e, prefix + "[]");
+          return;
+        }
+        if (!j.is_object() || prefix.ends_with(".contractions")) return;
+        for (const auto& [k, v] : j.items()) {
+          if (k.starts_with("//")) continue;
+          const std::string key = prefix.empty() ? k : prefix + "." + k;
+          EXPECT_THAT(all, HasSubstr("`" + key + "`"));
+          walk(v, key);
+        }
+      };
+  walk(shipped, "");
+  EXPECT_THROW((void)doc_blocks("no-such-topic"), Error);
 }
 
 TEST(SceneDocs, ExampleInTheDocIsTheShippedDefaultScene) {
