@@ -89,6 +89,19 @@ s = json.load(open(sys.argv[1])); s["skin"][0]["expression"] = "angery"
 json.dump(s, open(sys.argv[2], "w"))
 PY
 expect_error 1 'skin\[0\].expression' "$FOLLICLE" validate "$TMP/bad.json"
+# The head declared in cm instead of mm: the face setup's muscles lie far from its surface, and
+# the export is refused naming the numbers and the fix (before: a face without wrinkles, exit 0).
+python3 - "$TMP/angry.json" "$TMP/wrong_units.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+for m in s["assets"]["meshes"]:
+    if m.get("units") == "mm":
+        m["units"] = "cm"
+json.dump(s, open(sys.argv[2], "w"))
+PY
+expect_error 1 'the face setup does not fit this mesh: 17 of 17 muscles lie more than 2 cm from its surface.*check the mesh.s units' \
+  "$FOLLICLE" export "$TMP/wrong_units.json" --mesh "$TMP/wu.obj" --units mm
+[ -e "$TMP/wu.obj" ] && fail "a refused export left a file"
 
 [ $fails = 0 ] && echo "cli_skin: all passed"
 exit $fails

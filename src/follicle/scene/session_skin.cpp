@@ -14,6 +14,7 @@
 #include "follicle/render/lafortune.hpp"
 #include "follicle/scene/session.hpp"
 #include "follicle/scene/skin_runtime.hpp"
+#include "follicle/skin/setup_fit.hpp"
 #include "follicle/skin/skin_color_bando2002.hpp"
 
 namespace follicle::scene {
@@ -204,6 +205,13 @@ const skin::FaceRig& Session::face_rig(std::size_t ri) {
   const auto base = mesh(mesh_index(s.mesh));
   if (base->uvs.empty())
     fail("{}: the mesh has no texture coordinates; the wrinkles live in texture space", where);
+  // A setup made for another head or unit would deform nothing where it should and show no
+  // wrinkles, silently: measured and refused or warned with numbers (skin/setup_fit).
+  {
+    const auto fit = skin::measure_setup_fit(
+        *base, r.setup.muscles, s.wrinkles ? r.setup.wrinkles : std::vector<skin::LargeWrinkle>{});
+    for (const auto& w : skin::judge_setup_fit(fit, where)) m_ctx->log().warn("{}: {}", where, w);
+  }
   skin::FaceRigParams fp;
   fp.tissue = s.tissue;
   fp.refine = s.refine;
