@@ -23,27 +23,60 @@ sim::Ellipsoid HullSpec::ellipsoid() const {
 
 void HairStyleSpec::read_json_custom(const Json& j, const std::string& path,
                                      const JsonSource& src) {
-  if (j.is_string()) {
-    const auto name = j.get<std::string>();
-    const auto names = hair::style_preset_names();
-    for (const auto& n : names) {
-      if (n == name) {
-        preset = name;
-        custom.reset();
-        return;
-      }
-    }
+  const auto names = hair::style_preset_names();
+  auto check_preset = [&](const std::string& name, const std::string& at) {
+    if (std::find(names.begin(), names.end(), name) != names.end()) return;
     const std::string hint = suggest(name, names);
-    json_fail(src, path,
+    json_fail(src, at,
               "unknown hairstyle preset \"" + name + "\"" +
                   (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") + "; expected one of " +
                   detail::quoted_list(names) + " or a style object");
+  };
+  avoid_mesh.reset();
+  collision_margin.reset();
+  if (j.is_string()) {
+    check_preset(j.get<std::string>(), path);
+    preset = j.get<std::string>();
+    custom.reset();
+    return;
   }
   if (!j.is_object())
     json_fail(src, path,
               "expected a preset name (string) or a style object, got " + describe_json(j));
+  // Whole-style settings, allowed with a preset or beside a full style.
+  Json rest = j;
+  if (const auto it = rest.find("avoid_mesh"); it != rest.end()) {
+    if (!it->is_boolean())
+      json_fail(src, join_path(path, "avoid_mesh"),
+                "expected true or false, got " + describe_json(*it));
+    avoid_mesh = it->get<bool>();
+    rest.erase(it);
+  }
+  if (const auto it = rest.find("collision_margin"); it != rest.end()) {
+    const std::string at = join_path(path, "collision_margin");
+    if (!it->is_number()) json_fail(src, at, "expected a number (m), got " + describe_json(*it));
+    const double m = it->get<double>();
+    if (!(m >= 0 && m <= 0.05))
+      json_fail(src, at, fmt::format("{} m is out of range: expected [0, 0.05] m", m));
+    collision_margin = m;
+    rest.erase(it);
+  }
+  if (const auto it = rest.find("preset"); it != rest.end()) {
+    const std::string at = join_path(path, "preset");
+    if (!it->is_string())
+      json_fail(src, at, "expected a preset name (string), got " + describe_json(*it));
+    check_preset(it->get<std::string>(), at);
+    preset = it->get<std::string>();
+    rest.erase(it);
+    for (const auto& [key, value] : rest.items())
+      json_fail(src, join_path(path, key),
+                "a style with \"preset\" takes only \"avoid_mesh\" and \"collision_margin\" "
+                "besides it; to change its parts write the whole style without \"preset\"");
+    custom.reset();
+    return;
+  }
   hair::HairStyle st;
-  read_json(j, path, st, src);
+  read_json(rest, path, st, src);
   try {
     st.validate();
   } catch (const Error& e) {
@@ -53,15 +86,22 @@ void HairStyleSpec::read_json_custom(const Json& j, const std::string& path,
 }
 
 Json HairStyleSpec::to_json_custom() const {
-  if (custom) return to_json(*custom);
-  return Json(preset);
+  Json out = custom ? to_json(*custom) : Json(preset);
+  if (!avoid_mesh && !collision_margin) return out;
+  if (!custom) out = Json{{"preset", preset}};
+  if (avoid_mesh) out["avoid_mesh"] = *avoid_mesh;
+  if (collision_margin) out["collision_margin"] = *collision_margin;
+  return out;
 }
 
 hair::HairStyle HairStyleSpec::resolve(double density_scale) const {
-  if (!custom) return hair::style_preset(preset, density_scale);
-  hair::HairStyle st = *custom;
-  for (auto& part : st.parts)
-    for (auto& r : part.pores) r.density *= density_scale;
+  hair::HairStyle st = custom ? *custom : hair::style_preset(preset, density_scale);
+  for (auto& part : st.parts) {
+    if (custom)
+      for (auto& r : part.pores) r.density *= density_scale;
+    if (avoid_mesh) part.beam.avoid_mesh = *avoid_mesh;
+    if (collision_margin) part.beam.collision_margin = *collision_margin;
+  }
   return st;
 }
 

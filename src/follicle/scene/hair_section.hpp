@@ -52,17 +52,23 @@ struct HullSpec {
   sim::Ellipsoid ellipsoid() const;
 };
 
-/// "style": either a preset name ("bob", "swept_back", "ponytail", "short_cut") or a full
-/// HairStyle object (parts with pores, beam, fields, cuts, tie).
+/// "style": either a preset name ("bob", "swept_back", "ponytail", "short_cut"), a preset with
+/// whole-style settings ({"preset": "bob", "avoid_mesh": true, "collision_margin": 0.004}: every
+/// part's beam avoids the real head mesh, e.g. its ears, with that clearance), or a full
+/// HairStyle object (parts with pores, beam, fields, cuts, tie; "avoid_mesh" and
+/// "collision_margin" may be given beside them too).
 struct HairStyleSpec {
   using DocObject = hair::HairStyle;
   std::string preset = "bob";             // used when `custom` is empty
-  std::optional<hair::HairStyle> custom;  // the object form
+  std::optional<hair::HairStyle> custom;  // the full object form
+  std::optional<bool> avoid_mesh;         // whole-style settings, applied to every part's beam
+  std::optional<double> collision_margin;
 
   void read_json_custom(const Json& j, const std::string& path, const JsonSource& src);
   Json to_json_custom() const;
   static std::string doc_type_custom() {
-    return "string (preset: \"bob\", \"swept_back\", \"ponytail\", \"short_cut\") or object";
+    return "string (preset: \"bob\", \"swept_back\", \"ponytail\", \"short_cut\") or object "
+           "(a full style, or {\"preset\", \"avoid_mesh\", \"collision_margin\"})";
   }
   /// The style to grow, densities multiplied by `density_scale`.
   hair::HairStyle resolve(double density_scale) const;

@@ -3,7 +3,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "follicle/core/error.hpp"
+#include "follicle/geom/spatial_embree.hpp"
 #include "follicle/scene/session.hpp"
 #include "scene_test_util.hpp"
 #include "testing/testing.hpp"
@@ -51,6 +54,73 @@ TEST(HairScene, StyleIsAPresetNameOrAnObject) {
   EXPECT_EQ(write_scene(read_scene(w, JsonSource{})), w);
   // A preset stays a name.
   EXPECT_EQ(write_scene(read_scene(scene_json("anjyo_bob"), {}))["hair"][0]["style"], "bob");
+}
+
+TEST(HairScene, APresetTakesWholeStyleSettingsWithoutWritingOutTheStyle) {
+  // {"preset": "bob", "avoid_mesh": true}: the bob with every part's beam avoiding the head mesh
+  // (its ears), issue 21 item 7. Round trip, resolve, and the errors.
+  Json j = scene_json("anjyo_bob");
+  j["hair"][0]["style"] = {{"preset", "bob"}, {"avoid_mesh", true}, {"collision_margin", 0.004}};
+  const Scene s = read_scene(j, JsonSource{"x.json"});
+  EXPECT_FALSE(s.hair[0].style.custom);
+  EXPECT_EQ(s.hair[0].style.preset, "bob");
+  const auto st = s.hair[0].style.resolve(1.0);
+  const auto plain = HairStyleSpec{}.resolve(1.0);
+  ASSERT_EQ(st.parts.size(), plain.parts.size());
+  for (std::size_t p = 0; p < st.parts.size(); ++p) {
+    EXPECT_TRUE(st.parts[p].beam.avoid_mesh) << p;
+    EXPECT_DOUBLE_EQ(st.parts[p].beam.collision_margin, 0.004) << p;
+    EXPECT_FALSE(plain.parts[p].beam.avoid_mesh) << p;
+    EXPECT_EQ(st.parts[p].pores.size(), plain.parts[p].pores.size()) << p;
+  }
+  const Json w = write_scene(s);
+  EXPECT_EQ(w["hair"][0]["style"], j["hair"][0]["style"]);
+  EXPECT_EQ(write_scene(read_scene(w, JsonSource{})), w);
+  // Beside a full style the settings apply to its parts too.
+  j["hair"][0]["style"] = {{"parts", {{{"name", "a"}, {"pores", {{{"length", 0.1}}}}}}},
+                           {"avoid_mesh", true}};
+  EXPECT_TRUE(read_scene(j, JsonSource{}).hair[0].style.resolve(1.0).parts[0].beam.avoid_mesh);
+  // Errors name the key.
+  j["hair"][0]["style"] = {{"preset", "bob"}, {"parts", Json::array()}};
+  EXPECT_THAT(read_error(j), HasSubstr("hair[0].style.parts"));
+  EXPECT_THAT(read_error(j), HasSubstr("takes only \"avoid_mesh\" and \"collision_margin\""));
+  j["hair"][0]["style"] = {{"preset", "bobb"}};
+  EXPECT_THAT(read_error(j), HasSubstr("hair[0].style.preset"));
+  EXPECT_THAT(read_error(j), HasSubstr("did you mean \"bob\""));
+  j["hair"][0]["style"] = {{"preset", "bob"}, {"avoid_mesh", "yes"}};
+  EXPECT_THAT(read_error(j), HasSubstr("hair[0].style.avoid_mesh"));
+  j["hair"][0]["style"] = {{"preset", "bob"}, {"collision_margin", 0.5}};
+  EXPECT_THAT(read_error(j), HasSubstr("hair[0].style.collision_margin"));
+}
+
+TEST(HairScene, ABobAvoidingTheMeshKeepsTheEarsOfAnotherHeadUnderTheHair) {
+  // The ICT FaceKit head (held out: cm, prominent ears): the hull-only bob lets the ear poke
+  // through the hair; {"preset": "bob", "avoid_mesh": true} keeps the strands outside the mesh.
+  // Counted: strand nodes past the root segment lying more than 1 mm inside the head.
+  const auto ict = test::shared_data_dir() / "ict-facekit/generic_neutral_mesh.obj";
+  if (!std::filesystem::exists(ict)) GTEST_SKIP() << "needs " << ict;
+  Context ctx(2);
+  auto inside = [&](bool avoid) {
+    Json j = scene_json("anjyo_bob");
+    j["assets"]["meshes"][0] = {{"name", "head"}, {"path", ict.string()}, {"units", "cm"}};
+    j["hair"][0]["density_scale"] = 0.2;
+    j["hair"][0]["style"] = {{"preset", "bob"}, {"avoid_mesh", avoid}};
+    auto s = Session::from_json(j, scenes_dir(), "anjyo_bob", ctx);
+    const auto h = s.hair_strands(0, 0);
+    const geom::MeshQuery q(*s.mesh(0));
+    std::size_t deep = 0;
+    for (std::size_t i = 0; i < h->num_strands(); ++i)
+      for (uint32_t k = 2; k < h->strand_size(i); ++k) {
+        const Vec3 p = h->points[h->strand_begin(i) + k].cast<double>();
+        const auto c = q.closest_point(p);
+        if (c.face < 0 || c.distance < 0.001) continue;
+        deep += (p - c.point).dot(s.mesh(0)->face_normal(std::size_t(c.face))) < 0;
+      }
+    return deep;
+  };
+  const std::size_t without = inside(false), with = inside(true);
+  EXPECT_GT(without, 20u);  // the ear pokes through the hull-only bob (55 nodes; with: 0)
+  EXPECT_LT(with, without / 10 + 1) << "without " << without << ", with " << with;
 }
 
 TEST(HairScene, BadKeysNameTheJsonPath) {
