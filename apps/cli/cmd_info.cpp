@@ -29,22 +29,22 @@ std::string unit_source(bool given) {
                : "assumed: no --units given, and this format does not record a unit";
 }
 
-// A head is 0.2-0.3 m across, a bust up to 0.6 m, a hand about 0.2 m: a mesh far outside
-// 5 cm - 3 m in the declared unit was probably written in another one. Names the unit that makes
-// it body-sized (a 34 m "head" from a file in cm read as m is the usual case).
+// A head is 0.2-0.3 m across, a bust up to 0.6 m, a hand about 0.2 m, a body under 3 m: a mesh
+// far outside 5 cm - 3 m in the declared unit was probably written in another one (a 34 m "head"
+// from a file in cm read as m is the usual case).
 void size_note(double diag_m, LengthUnit unit, bool given) {
   if (diag_m >= 0.05 && diag_m <= 3.0) return;
+  // Every unit that makes it body-part-sized or body-sized: a file of 20 units may be a head in
+  // cm or a whole body in dm (MakeHuman's base mesh), so neither is picked for the user.
   std::string hint;
   for (LengthUnit u : {LengthUnit::mm, LengthUnit::cm, LengthUnit::dm, LengthUnit::m}) {
     const double d = diag_m / unit_to_metres(unit) * unit_to_metres(u);
-    if (u != unit && d >= 0.1 && d <= 1.0) {
-      hint = fmt::format("; with --units {} it is {:.2f} m across, the size of a head or bust",
-                         to_string(u), d);
-      break;
-    }
+    if (u != unit && d >= 0.05 && d <= 3.0)
+      hint += fmt::format("{} --units {} it is {:.2f} m across", hint.empty() ? "; with" : ", with",
+                          to_string(u), d);
   }
-  fmt::print("note: {:.3g} m across in {} ({}) is not the size of a head, bust or hand{}\n", diag_m,
-             to_string(unit), given ? "declared" : "assumed", hint);
+  fmt::print("note: {:.3g} m across in {} ({}) is not the size of a head, bust, hand or body{}\n",
+             diag_m, to_string(unit), given ? "declared" : "assumed", hint);
 }
 
 void mesh_info(const std::string& path, LengthUnit unit, bool unit_given) {

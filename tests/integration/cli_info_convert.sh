@@ -18,7 +18,7 @@ grep -q '^note:' "$TMP/info0" && fail "a head in mm declared mm got a size note"
 # which the note names with the unit that fits.
 "$FOLLICLE" info "$MESH" >"$TMP/info_nounits" 2>"$TMP/err" || { fail "info without units"; cat "$TMP/err"; }
 grep -q '^units: m (assumed: no --units given' "$TMP/info_nounits" || fail "assumed unit not said: $(grep units "$TMP/info_nounits")"
-grep -q "^note: .* m across in m (assumed) is not the size of a head, bust or hand; with --units mm it is 0\.[0-9][0-9] m across" "$TMP/info_nounits" \
+grep -q "^note: .* m across in m (assumed) is not the size of a head, bust, hand or body; with --units mm it is 0\.[0-9][0-9] m across" "$TMP/info_nounits" \
   || fail "size note: $(grep note "$TMP/info_nounits")"
 
 "$FOLLICLE" info "$ROOT/data/scenes/default.json" >"$TMP/sinfo" 2>"$TMP/err" || { fail "info scene"; cat "$TMP/err"; }
