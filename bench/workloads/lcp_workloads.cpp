@@ -48,8 +48,9 @@ class LcpStepInstance : public WorkloadInstance {
     sp.spacing = 0.012;
     const double n0 = double(hair::LcpScenario(ctx, sp).state().x.size());
     sp.spacing = 0.012 * std::cbrt(n0 / target);
-    m_scene =
-        std::make_unique<hair::LcpScenario>(ctx, sp, frame ? hair::LcpParams{} : fixed_params());
+    hair::LcpParams fp;
+    if (frame && s.at("implicit") != 0) fp.integrator = "implicit";
+    m_scene = std::make_unique<hair::LcpScenario>(ctx, sp, frame ? fp : fixed_params());
     // Leave the rest state: 20 ms of falling in stable 0.2 ms sub-steps (a single 1 ms leapfrog
     // sub-step is beyond the CFL limit and blew the hair up, so the benchmark used to time an
     // exploded state with particles at up to 100 m/s).
@@ -157,8 +158,9 @@ void add_lcp_workloads(std::vector<Workload>& out) {
                  }});
   out.push_back(
       {"lcp-frame",
-       "LCP hair (Bando 2003): one 1/60 s frame of the back hair, adaptive leapfrog sub-steps",
-       {{"particles", 2000}, {"simd", 1}},
+       "LCP hair (Bando 2003): one 1/60 s frame of the back hair; implicit=1: the implicit "
+       "integrator (ADR 0014), 0: adaptive leapfrog sub-steps",
+       {{"particles", 2000}, {"simd", 1}, {"implicit", 1}},
        "particles/s",
        [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
          return std::make_unique<LcpStepInstance>(ctx, s, true);

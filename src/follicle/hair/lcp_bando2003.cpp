@@ -30,6 +30,11 @@ void LcpInitParams::validate() const {
 
 void LcpParams::validate() const {
   validate_params(*this, "lcp");
+  if (integrator != "leapfrog" && integrator != "implicit") {
+    const std::string hint = did_you_mean(integrator, {"leapfrog", "implicit"});
+    fail_at("lcp.integrator", "expected \"leapfrog\" or \"implicit\", got \"{}\"{}", integrator,
+            hint.empty() ? std::string() : fmt::format(" (did you mean \"{}\"?)", hint));
+  }
   contact.validate();
 }
 
@@ -608,6 +613,11 @@ void LcpSolver::coefficients_of(std::size_t i, const LcpState& s, LcpWorkspace& 
   if (best != uint32_t(-1)) ws.k[best] = m.c[best] * m_ks.w(kTetherFraction * 2 * m.h_s);
 }
 
+void LcpSolver::coefficients_from_geometry(std::size_t i, const LcpState& s,
+                                           LcpWorkspace& ws) const {
+  coefficients_of(i, s, ws, [&](uint32_t q) { return ws.conn_r[q]; });
+}
+
 void LcpSolver::alpha_sums_of(std::size_t i, LcpWorkspace& ws) const {
   const auto& m = m_model;
   double sr = 0, st = 0;
@@ -743,16 +753,16 @@ bool same_bits(const Context& ctx, const std::vector<Vec3>& a, const std::vector
              },
              [](int x, int y) { return x & y; }) != 0;
 }
+}  // namespace
 
 /// max |x_i - x_i(list build) - u|^2 over i0 <= i < i1 (0 for an empty range).
-double max_shift2(const LcpState& s, const LcpWorkspace& ws, const Vec3& u, std::size_t i0,
-                  std::size_t i1) {
+double LcpSolver::max_shift2(const LcpState& s, const LcpWorkspace& ws, const Vec3& u,
+                             std::size_t i0, std::size_t i1) {
   double m = 0;
   for (std::size_t i = i0; i < i1; ++i)
     m = std::max(m, (s.x[i] - ws.nbr_built_x[i] - u).squaredNorm());
   return m;
 }
-}  // namespace
 
 bool LcpSolver::lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& ws,
                            double lim) const {
@@ -794,11 +804,10 @@ bool LcpSolver::lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& 
   return true;
 }
 
-namespace {
 /// For sorted and mirrored lists: the first entry of each list with a neighbour index above the
 /// particle's own (nbr_upper), the pair slots of each particle (pair_off) and the pair slot of
 /// every entry (nbr_pair).
-void pair_index(const Context& ctx, LcpWorkspace& ws) {
+void LcpSolver::pair_index(const Context& ctx, LcpWorkspace& ws) {
   const auto& off = ws.nbr_offsets;
   const auto& nb = ws.nbrs;
   const std::size_t n = off.empty() ? 0 : off.size() - 1;
@@ -828,7 +837,6 @@ void pair_index(const Context& ctx, LcpWorkspace& ws) {
     }
   });
 }
-}  // namespace
 
 void LcpSolver::pair_scratch(LcpWorkspace& ws) {
   const std::size_t npairs = ws.pair_off.empty() ? 0 : ws.pair_off.back();
@@ -1031,6 +1039,7 @@ void LcpSolver::update_directions(const Context& ctx, LcpState& s, const LcpWork
 
 LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpState& s,
                               LcpWorkspace& ws) const {
+  if (m_params.integrator == "implicit") return step_implicit(ctx, in, s, ws);
   LcpStepReport rep;
   const auto& m = m_model;
   const auto& P = m_params;

@@ -62,8 +62,33 @@ struct LcpInitParams {
   void validate() const;
 };
 
+/// The implicit integrator (ADR 0014): each sub-step is one linearised backward-Euler step of the
+/// thesis's forces (Baraff & Witkin 1998): the loose springs (3.7)-(3.14) with their damping, the
+/// SPH pressure (3.16) through its pair stiffness, the hair-hair damping (3.17)/(3.18) and the air
+/// drag enter the matrix, solved by conjugate gradients; gravity, inertial forces and wind are
+/// explicit, the body contact (3.19)-(3.24) acts on the solved velocity. The sub-step is set by
+/// how far particles move (cfl: the fastest particle moves at most cfl h per sub-step, h the
+/// hair-hair smoothing length), not by the spring stiffness.
+struct LcpImplicitParams {
+  int min_substeps = 1;      // sub-steps per step() at least
+  double cfl = 0.5;          // largest displacement per sub-step / h
+  double tolerance = 1e-3;   // conjugate gradients stop at |r| <= tolerance |b|
+  int max_iterations = 200;  // conjugate-gradient iteration cap per sub-step
+  template <class V>
+  void visit(V&& v) {
+    v("min_substeps", min_substeps, ParamInfo{"minimum implicit sub-steps per step", "", 1, 10000});
+    v("cfl", cfl, ParamInfo{"largest displacement per sub-step / h", "", 0.01, 4});
+    v("tolerance", tolerance, ParamInfo{"relative residual of the linear solve", "", 1e-12, 0.5});
+    v("max_iterations", max_iterations, ParamInfo{"linear-solve iteration cap", "", 1, 100000});
+  }
+};
+
 /// Dynamics (§3.3.2, §3.3.3, §3.5, §3.6).
 struct LcpParams {
+  // "leapfrog": the explicit reference integration (adaptive sub-steps by `cfl`); "implicit":
+  // LcpImplicitParams (ADR 0014).
+  std::string integrator = "leapfrog";
+  LcpImplicitParams implicit;
   int substeps = 4;                 // minimum sub-steps per step()
   double cfl = 0.5;                 // adaptive sub-steps: omega_max dt_sub <= cfl (0 = fixed)
   int max_substeps = 2000;          // cap of the adaptive sub-step count
@@ -90,7 +115,10 @@ struct LcpParams {
   double neighbour_skin = 0.15;
   template <class V>
   void visit(V&& v) {
-    v("substeps", substeps, ParamInfo{"minimum sub-steps per step", "", 1, 10000});
+    v("integrator", integrator,
+      ParamInfo{"leapfrog (explicit reference) | implicit (linearised backward Euler, ADR 0014)"});
+    v("implicit", implicit);
+    v("substeps", substeps, ParamInfo{"minimum leapfrog sub-steps per step", "", 1, 10000});
     v("cfl", cfl, ParamInfo{"stability factor of the adaptive sub-step", "", 0, 2});
     v("max_substeps", max_substeps, ParamInfo{"sub-step cap", "", 1, 1000000});
     v("gravity", gravity, ParamInfo{"gravity", "m/s^2", -1000, 1000});
@@ -152,6 +180,8 @@ struct LcpState {
 /// LCP specifics.
 struct LcpStepReport : sim::StepReport {
   int substeps = 0;              // sub-steps taken
+  int solver_iterations = 0;     // implicit: conjugate-gradient iterations over all sub-steps
+  double solver_residual = 0;    // implicit: largest relative residual a sub-step ended with
   double max_penetration = 0;    // [m] deepest particle below a body plane (>= 0)
   std::size_t num_contacts = 0;  // particles in contact at the last sub-step
 };
@@ -220,6 +250,16 @@ struct LcpWorkspace {
     double max_pen = 0;        // deepest penetration [m] (last sub-step)
   };
   std::vector<ChunkCheck> chunk_check;
+  // Implicit sub-step (LcpSolver::step_implicit, ADR 0014). Per connection: the stiffness along
+  // x^_ab (alpha k, scaled when compressed), across it (the tension alpha k (1 - l0/r) >= 0) and
+  // the damping along it; per pair slot: x^_ij, d^_n (3.17) and the pair's stiffness (3.16),
+  // collision (3.17) and friction (3.18) damping coefficients.
+  std::vector<double> imp_spar, imp_sperp, imp_cpar;
+  std::vector<Vec3> imp_pxh, imp_pdh;
+  std::vector<double> imp_pk, imp_pc, imp_pf;
+  std::vector<Vec3> imp_dv, imp_r, imp_z, imp_p, imp_q, imp_b, imp_v0;
+  std::vector<Mat3> imp_dinv;    // inverse diagonal blocks (block-Jacobi preconditioner)
+  std::vector<double> imp_part;  // per-chunk partial sums of the dot products
 };
 
 /// Builds the connections (§3.3.1, (3.5)-(3.6), pruning by a0 and N_n) for given particles.
@@ -266,6 +306,11 @@ class LcpSolver {
   LcpStepReport step(const Context& ctx, const LcpStepInput& in, LcpState& state,
                      LcpWorkspace& ws) const;
 
+  /// Advances `state` by in.dt with the implicit integrator (params.implicit, ADR 0014), whatever
+  /// params.integrator says; step() calls it when params.integrator is "implicit".
+  LcpStepReport step_implicit(const Context& ctx, const LcpStepInput& in, LcpState& state,
+                              LcpWorkspace& ws) const;
+
   /// The initial state (rest positions and directions, zero velocity).
   LcpState rest_state() const;
 
@@ -298,6 +343,15 @@ class LcpSolver {
 
  private:
   void rebuild_neighbours(const Context& ctx, const LcpState& s, LcpWorkspace& ws) const;
+  static void pair_index(const Context& ctx, LcpWorkspace& ws);
+  static double max_shift2(const LcpState& s, const LcpWorkspace& ws, const Vec3& u, std::size_t i0,
+                           std::size_t i1);
+  // Implicit sub-step pieces (lcp_implicit_bando2003.cpp).
+  void implicit_blocks(const Context& ctx, const LcpState& s, LcpWorkspace& ws, double dt,
+                       double drag) const;
+  void implicit_apply(const Context& ctx, LcpWorkspace& ws, const std::vector<Vec3>& u,
+                      std::vector<Vec3>& out, double ch, double sh, double drag_h,
+                      bool with_mass) const;
   /// Whether the Verlet lists still hold every pair within 2h, from ws.chunk_shift (may set
   /// ws.nbr_shift).
   bool lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& ws, double lim) const;
@@ -305,6 +359,8 @@ class LcpSolver {
   // Per-particle pieces shared by the public functions and the fused sub-step of step().
   template <class R>
   void coefficients_of(std::size_t i, const LcpState& s, LcpWorkspace& ws, R&& r_of) const;
+  // coefficients_of with |x_ab| from the cached geometry ws.conn_r.
+  void coefficients_from_geometry(std::size_t i, const LcpState& s, LcpWorkspace& ws) const;
   void alpha_sums_of(std::size_t i, LcpWorkspace& ws) const;
   void alpha_of(std::size_t i, LcpWorkspace& ws) const;
   void alpha_sweeps(const Context& ctx, LcpWorkspace& ws) const;

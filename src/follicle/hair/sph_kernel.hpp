@@ -56,6 +56,12 @@ struct SphKernel {
     w = sigma_w * 0.25 * (a * a * a - 4.0 * b * b * b);
     dw = sigma_dw * 0.75 * (4.0 * b * b - a * a);
   }
+  /// d^2W/dr^2 at r [1/m^5] (the pair stiffness of the implicit step, ADR 0014).
+  double d2w(double r) const {
+    const double q = r * inv_h;
+    const double a = std::max(2.0 - q, 0.0), b = std::max(1.0 - q, 0.0);
+    return sigma_dw * inv_h * 1.5 * (a - 4.0 * b);
+  }
 };
 
 }  // namespace follicle::hair

@@ -112,12 +112,13 @@ Sheets crossing_sheets(const Context& ctx) {
 
 // Minimum over time of mean z(sheet 1) - mean z(sheet 0): negative when the sheets passed
 // through each other.
-double sheet_separation(bool hair_hair) {
+double sheet_separation(bool hair_hair, const char* integrator = "leapfrog") {
   Context ctx(2);
   Sheets sh = crossing_sheets(ctx);
   for (std::size_t q = 0; q < sh.model.num_pairs(); ++q)
     EXPECT_EQ(sh.sheet[sh.model.pair_a[q]], sh.sheet[sh.model.pair_b[q]]);
   LcpParams p;
+  p.integrator = integrator;
   p.hair_hair = hair_hair;
   p.gravity = Vec3::Zero();
   p.air_drag = 0;
@@ -152,6 +153,219 @@ TEST(LcpPhysics, HairHairInteractionStopsCrossingSheets) {
               with * 1e3, without * 1e3);
   EXPECT_GT(with, 0.0);     // they do not pass through each other (Fig. 3.7 c)
   EXPECT_LT(without, 0.0);  // they do (Fig. 3.7 d)
+}
+
+// ---------------------------------------------------------------------------------------------
+// The implicit integrator (ADR 0014) against the leapfrog reference on physical cases.
+
+// Fig. 3.7 again: the sheets stop each other with the implicit step too, pass through each other
+// without hair-hair interaction, and the closest approach agrees with the leapfrog's.
+TEST(LcpImplicit, CrossingSheetsAgreeWithTheLeapfrog) {
+  const double lf = sheet_separation(true);
+  const double with = sheet_separation(true, "implicit"),
+               without = sheet_separation(false, "implicit");
+  std::printf(
+      "crossing sheets, implicit: min separation with hair-hair %.1f mm (leapfrog %.1f mm), "
+      "without %.1f mm\n",
+      with * 1e3, lf * 1e3, without * 1e3);
+  EXPECT_GT(with, 0.0);
+  EXPECT_LT(without, 0.0);
+  EXPECT_NEAR(with, lf, 0.25 * lf);
+}
+
+namespace {
+struct SagResult {
+  double mean_y = 0, tip_y = 0, stretch = 0;
+  int substeps = 0;
+};
+// The small sphere scene hanging under gravity from its rest shape, 1/60 s steps, with more air
+// drag than the default so that the swing settles into the static shape.
+SagResult static_sag(const char* integrator, int threads = 2, LcpState* out = nullptr,
+                     int frames = 180) {
+  Context ctx(threads);
+  const auto sc = test::lcp_small_scene(ctx, 0.012, 0.12);
+  LcpParams p;
+  p.integrator = integrator;
+  p.air_drag = 8;
+  LcpSolver solver(p, sc.init.model, &sc.body);
+  LcpState s = solver.rest_state();
+  LcpWorkspace ws;
+  SagResult r;
+  for (int k = 0; k < frames; ++k) {
+    LcpStepInput in;
+    in.dt = 1.0 / 60;
+    const auto rep = solver.step(ctx, in, s, ws);
+    EXPECT_TRUE(rep.ok) << rep.message;
+    r.substeps += rep.substeps;
+  }
+  const auto& m = solver.model();
+  int nf = 0, nt = 0;
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    if (m.root[i]) continue;
+    r.mean_y += s.x[i].y();
+    ++nf;
+    if (m.uvs[i].z() > 0.08) {
+      r.tip_y += s.x[i].y();
+      ++nt;
+    }
+  }
+  r.mean_y /= nf;
+  r.tip_y /= std::max(nt, 1);
+  for (std::size_t q = 0; q < m.num_pairs(); ++q)
+    r.stretch += (s.x[m.pair_b[q]] - s.x[m.pair_a[q]]).norm() / m.l0[q];
+  r.stretch /= double(m.num_pairs());
+  if (out) *out = s;
+  return r;
+}
+}  // namespace
+
+// Hair draped on a head: after 3 s under gravity both integrations come to nearly the same
+// hanging shape, the implicit one in a small fraction of the sub-steps. Not to the same bits of
+// shape: the hair rests on the head with Coulomb friction (3.22)/(3.23), which holds any of a range
+// of rest shapes, and the two paths (the implicit step damps the first swing more) end at
+// different ones; they differ by less than half the particle spacing (12 mm).
+TEST(LcpImplicit, HairOnAHeadSettlesAsWithTheLeapfrog) {
+  const SagResult lf = static_sag("leapfrog"), im = static_sag("implicit");
+  std::printf(
+      "static sag: mean y %.2f / %.2f mm, tips %.2f / %.2f mm, stretch %.4f / %.4f, "
+      "sub-steps %d / %d (leapfrog / implicit)\n",
+      lf.mean_y * 1e3, im.mean_y * 1e3, lf.tip_y * 1e3, im.tip_y * 1e3, lf.stretch, im.stretch,
+      lf.substeps, im.substeps);
+  EXPECT_NEAR(im.mean_y, lf.mean_y, 0.006);
+  EXPECT_NEAR(im.tip_y, lf.tip_y, 0.006);
+  EXPECT_NEAR(im.stretch, lf.stretch, 0.005);
+  EXPECT_LT(im.substeps * 5, lf.substeps);
+}
+
+// The same bits for one and two threads.
+TEST(LcpImplicit, IdenticalForOneAndTwoThreads) {
+  LcpState a, b;
+  static_sag("implicit", 1, &a, 60);
+  static_sag("implicit", 2, &b, 60);
+  ASSERT_EQ(a.x.size(), b.x.size());
+  for (std::size_t i = 0; i < a.x.size(); ++i) {
+    ASSERT_EQ(a.x[i], b.x[i]) << i;
+    ASSERT_EQ(a.v[i], b.v[i]) << i;
+    ASSERT_EQ(a.t[i], b.t[i]) << i;
+  }
+}
+
+namespace {
+// One straight strand of 60 particles 5 mm apart (two of them roots), 10 mg each, hanging along -y.
+struct Strand {
+  static constexpr double a = 0.005, mass = 1e-5;
+  static constexpr int len = 60;
+  LcpModel model;
+  explicit Strand(const Context& ctx) {
+    const LcpStrandBlock block = lcp_strand_block(1, 1, len, a);
+    LcpInitParams ip;
+    ip.spacing = a;
+    model = connect_particles(ctx, block.x, block.t, block.uvs,
+                              std::vector<double>(block.x.size(), mass), ip);
+  }
+  // The strand's axial stiffness E A_eff [N]: a uniform strain e stretches every connection by
+  // e l0 and n = l0 / a of them cross any cut, so the tension is e sum_q alpha k l0^2 / a over the
+  // root-side connections of a particle in the middle. (Not E A: (3.10) gives every particle the
+  // modulus E over its connections, and a connection two spacings long crosses two cuts.)
+  double axial_stiffness(const Context& ctx, const LcpSolver& solver) const {
+    LcpWorkspace ws;
+    const LcpState s = solver.rest_state();
+    solver.solve_alpha(ctx, s, ws);
+    const uint32_t mid = len / 2;
+    double k = 0;
+    for (std::size_t q = 0; q < model.num_pairs(); ++q)
+      if (model.pair_b[q] == mid) k += ws.alpha[q] * ws.k[q] * model.l0[q] * model.l0[q] / a;
+    return k;
+  }
+};
+}  // namespace
+
+// Static sag of a hanging strand under its own weight (no hair-hair interaction, no body): the
+// tip drops by mu g L^2 / (2 E A_eff), mu = m / a. Both integrations settle there.
+TEST(LcpImplicit, AHangingStrandSagsAsTheAnalyticBarWithBothIntegrators) {
+  Context ctx(2);
+  const Strand strand(ctx);
+  double sag[2] = {0, 0}, expect = 0;
+  int subs[2] = {0, 0};
+  for (int mode = 0; mode < 2; ++mode) {
+    LcpParams p;
+    p.integrator = mode == 0 ? "leapfrog" : "implicit";
+    p.hair_hair = false;
+    p.air_drag = 20;  // settles within the run
+    LcpSolver solver(p, strand.model);
+    LcpState s = solver.rest_state();
+    LcpWorkspace ws;
+    for (int k = 0; k < 120; ++k) {
+      LcpStepInput in;
+      in.dt = 1.0 / 60;
+      const auto rep = solver.step(ctx, in, s, ws);
+      ASSERT_TRUE(rep.ok) << rep.message;
+      subs[mode] += rep.substeps;
+    }
+    const std::size_t tip = s.x.size() - 1;
+    sag[mode] = solver.model().rest_x[tip].y() - s.x[tip].y();
+    const double L = Strand::a * (Strand::len - 2);
+    expect = Strand::mass / Strand::a * 9.81 * L * L / (2 * strand.axial_stiffness(ctx, solver));
+  }
+  std::printf(
+      "hanging strand: tip sag %.4f mm (leapfrog, %d sub-steps), %.4f mm (implicit, %d), "
+      "bar %.4f mm\n",
+      sag[0] * 1e3, subs[0], sag[1] * 1e3, subs[1], expect * 1e3);
+  EXPECT_NEAR(sag[0], expect, 0.1 * expect);
+  EXPECT_NEAR(sag[1], sag[0], 0.02 * sag[0]);
+  EXPECT_LT(subs[1] * 10, subs[0]);
+}
+
+namespace {
+// A single straight strand (len particles, spacing a, hanging along -y from two root particles),
+// no gravity, every free particle given 5 cm/s away from the root at t = 0: a fixed-free bar.
+// The stretch wave that starts at the held root stops each particle it passes; when it reaches
+// the free tip, at t = L / c, it reflects and turns the tip's velocity round. Returns the time the
+// tip's velocity first turns towards the root.
+double tip_reversal_time(const char* integrator, double* c_analytic) {
+  Context ctx(2);
+  const Strand strand(ctx);
+  LcpParams p;
+  p.integrator = integrator;
+  p.gravity = Vec3::Zero();
+  p.air_drag = 0;
+  p.spring_damping = 0;
+  p.hair_hair = false;
+  LcpSolver solver(p, strand.model);
+  LcpState s = solver.rest_state();
+  const auto& m = solver.model();
+  const std::size_t tip = s.x.size() - 1;
+  for (std::size_t i = 0; i < s.x.size(); ++i)
+    if (!m.root[i]) s.v[i] = Vec3(0, -0.05, 0);
+  *c_analytic = std::sqrt(strand.axial_stiffness(ctx, solver) * Strand::a / Strand::mass);
+  LcpWorkspace ws;
+  const double dt = 5e-4;
+  for (int k = 0; k < 4000; ++k) {
+    LcpStepInput in;
+    in.dt = dt;
+    const auto rep = solver.step(ctx, in, s, ws);
+    EXPECT_TRUE(rep.ok) << rep.message;
+    if (s.v[tip].y() > 0) return (k + 1) * dt;
+  }
+  return -1;
+}
+}  // namespace
+
+// A stretch wave's speed along a strand: the tip of a fixed-free strand turns back when the wave
+// from the root arrives, at L / c. Both integrations agree with each other and with
+// c = sqrt(E A_eff / mu) of the strand's connections (3.7)-(3.14) and cross-section (3.9).
+TEST(LcpImplicit, AStretchWaveRunsAlongAStrandAtTheSameSpeed) {
+  double c = 0;
+  const double lf = tip_reversal_time("leapfrog", &c), im = tip_reversal_time("implicit", &c);
+  const double L = Strand::a * (Strand::len - 2);  // the free part of the strand
+  std::printf(
+      "strand wave: tip turns at %.1f ms (leapfrog), %.1f ms (implicit), L/c = %.1f ms "
+      "(c = %.2f m/s)\n",
+      lf * 1e3, im * 1e3, L / c * 1e3, c);
+  ASSERT_GT(lf, 0);
+  ASSERT_GT(im, 0);
+  EXPECT_NEAR(im, lf, 0.1 * lf);
+  EXPECT_NEAR(lf, L / c, 0.1 * (L / c));
 }
 
 TEST(LcpPhysics, BackHairHangsUnderGravityPicture) {
