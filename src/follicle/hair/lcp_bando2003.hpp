@@ -71,8 +71,8 @@ struct LcpInitParams {
 /// hair-hair smoothing length), not by the spring stiffness.
 struct LcpImplicitParams {
   int min_substeps = 1;      // sub-steps per step() at least
-  double cfl = 0.5;          // largest displacement per sub-step / h
-  double tolerance = 1e-3;   // conjugate gradients stop at |r| <= tolerance |b|
+  double cfl = 1.0;          // largest displacement per sub-step / h
+  double tolerance = 1e-2;   // conjugate gradients stop at |r| <= tolerance |b|
   int max_iterations = 200;  // conjugate-gradient iteration cap per sub-step
   template <class V>
   void visit(V&& v) {

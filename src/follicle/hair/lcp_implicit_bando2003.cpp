@@ -298,11 +298,29 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
   const double accel = (g_h - A_h).norm() + al_h.norm() * 0.5 + w_h.squaredNorm() * 0.5;
   double elapsed = 0;
   int taken = 0;
+  // Whether any particle touched the body in the last sub-step (before the first: whether one
+  // lies within the contact band now).
+  bool in_contact = false;
+  if (P.body_collision && m_body)
+    in_contact = deterministic_reduce(
+                     ctx, n, 4096, 0,
+                     [&](std::size_t i0, std::size_t i1) {
+                       for (std::size_t i = i0; i < i1; ++i) {
+                         if (m.root[i]) continue;
+                         const sim::BodyPlane* pl = m_body->find(s.x[i]);
+                         if (pl && (s.x[i] - pl->p).dot(pl->n) < P.contact.threshold) return 1;
+                       }
+                       return 0;
+                     },
+                     [](int x, int y) { return x | y; }) != 0;
   const int cap = std::max(P.max_substeps, IP.min_substeps);
   while (true) {
     const double rem = in.dt - elapsed;
     const double v_est = (std::isfinite(vmax) ? vmax : 0.0) + accel * longest;
-    const double allowed = v_est > 0 ? std::min(longest, IP.cfl * h / v_est) : longest;
+    // With particles in contact the sub-step also keeps them within the contact band of (3.19):
+    // the velocity-level rule (3.20)-(3.24) sees a particle once per sub-step.
+    const double reach = in_contact ? std::min(IP.cfl * h, P.contact.threshold) : IP.cfl * h;
+    const double allowed = v_est > 0 ? std::min(longest, reach / v_est) : longest;
     int left = int(std::min<double>(std::ceil(rem / allowed * (1 - 1e-12)), 1e9));
     left = std::clamp(left, 1, std::max(1, cap - taken));
     const double dt = left == 1 ? rem : rem / left;
@@ -481,6 +499,7 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
     rep.num_contacts = chk.contacts;
     rep.max_penetration = chk.max_pen;
     vmax = chk.vmax;
+    in_contact = chk.contacts > 0;
     if (chk.bad != SIZE_MAX) {
       const double sp = s.v[chk.bad].norm();
       if (std::isfinite(sp) && s.x[chk.bad].allFinite() && s.t[chk.bad].allFinite())
