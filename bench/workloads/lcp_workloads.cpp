@@ -17,6 +17,11 @@
 //    step (allocation). A blow-up fails the benchmark. (Until the ninth session dt was a fixed
 //    0.2 ms, twice the stable sub-step: the hair's speed grew without bound and the run blew up
 //    after ≈ 400 steps; until the tenth the air stepped with every hair step.)
+//  - "lcp-wind-frame": the same block and air, one 1/60 s animation frame per iteration with the
+//    implicit hair integrator (ADR 0014): the air over the frame first (SphAir::step sub-steps at
+//    its stable step, the hair held at the frame's start), then one implicit hair step of the
+//    frame with the air's mean drag (as the scenes couple, once per scene step). Size "implicit"
+//    of "lcp-frame" (default 1) selects the same integrator there (0: adaptive leapfrog).
 // Size "simd" (default 1): 0 runs the scalar hair-hair pair loop instead of the AVX2 batch
 // kernel (same results, ADR 0008), for A/B timing.
 #include <cmath>
@@ -80,7 +85,8 @@ class LcpStepInstance : public WorkloadInstance {
 // step per iteration.
 class LcpWindInstance : public WorkloadInstance {
  public:
-  LcpWindInstance(const Context& ctx, const Sizes& s) : m_ctx(ctx) {
+  LcpWindInstance(const Context& ctx, const Sizes& s, bool frame = false)
+      : m_ctx(ctx), m_frame(frame) {
     const double a = 0.005;
     const int len = 100;  // particles per strand
     const int strands = std::max(1, int(std::lround(s.at("hair") / len)));
@@ -93,6 +99,7 @@ class LcpWindInstance : public WorkloadInstance {
     hair::LcpParams p;
     p.substeps = 1;
     p.cfl = 0;
+    if (frame) p.integrator = "implicit";
     m_solver = std::make_unique<hair::LcpSolver>(
         p, hair::connect_particles(ctx, block.x, block.t, block.uvs, mass, ip));
     m_solver->use_simd(s.at("simd") != 0);
@@ -111,19 +118,20 @@ class LcpWindInstance : public WorkloadInstance {
     m_na = double(m_air->size());
     // The sub-step the adaptive rule (default cfl) takes at the rest state.
     hair::LcpWorkspace probe;
-    m_dt = hair::LcpParams{}.cfl / m_solver->stiffness_rate(ctx, m_state, probe);
+    m_dt = frame ? 1.0 / 60 : hair::LcpParams{}.cfl / m_solver->stiffness_rate(ctx, m_state, probe);
     if (!(m_dt > 0) || !std::isfinite(m_dt)) fail("lcp-wind: no stable time step ({})", m_dt);
     // Hair steps per air step: the air's own stable step (coupled), or as given.
-    const double every = s.at("air_every");
+    const double every = frame ? 1.0 : s.at("air_every");
     if (!(every >= 0) || every > 1e6 || every != std::floor(every))
       fail("lcp-wind: air_every must be a whole number >= 0 (0: the air's stable step), got {}",
            every);
     m_coupling = hair::LcpWindCoupling(
         every > 0 ? int(every) : hair::LcpWindCoupling::air_every(ctx, *m_air, m_dt));
     ctx.log().info(
-        "lcp-wind: {} hair + {} air particles, hair step {:.4f} ms, an air step every {} "
+        "{}: {} hair + {} air particles, hair step {:.4f} ms, an air step every {} "
         "hair steps",
-        block.x.size(), m_air->size(), 1e3 * m_dt, m_coupling.every());
+        m_frame ? "lcp-wind-frame" : "lcp-wind", block.x.size(), m_air->size(), 1e3 * m_dt,
+        m_coupling.every());
     // One untimed step: it allocates the workspaces and faults in their pages (≈ 0.3 s at the
     // default sizes), which every later step reuses; timing it added ≈ 6 ms to the mean step
     // of a 3 s run.
@@ -136,6 +144,7 @@ class LcpWindInstance : public WorkloadInstance {
 
  private:
   const Context& m_ctx;
+  bool m_frame = false;
   std::unique_ptr<hair::LcpSolver> m_solver;
   hair::LcpState m_state;
   hair::LcpWorkspace m_ws;
@@ -173,6 +182,15 @@ void add_lcp_workloads(std::vector<Workload>& out) {
                  "steps/s",
                  [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
                    return std::make_unique<LcpWindInstance>(ctx, s);
+                 }});
+  out.push_back({"lcp-wind-frame",
+                 "LCP hair in SPH wind (Bando 2003 §3.6): one 1/60 s frame of the implicit hair "
+                 "(ADR 0014), the air first over the frame at its own stable sub-steps with the "
+                 "hair at the frame's start, its mean drag then the hair's external force",
+                 {{"hair", 100000}, {"air", 25000}, {"simd", 1}},
+                 "frames/s",
+                 [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
+                   return std::make_unique<LcpWindInstance>(ctx, s, true);
                  }});
 }
 

@@ -117,7 +117,8 @@ struct LcpParams {
   void visit(V&& v) {
     v("integrator", integrator,
       ParamInfo{"leapfrog (explicit reference) | implicit (linearised backward Euler, ADR 0014)"});
-    v("implicit", implicit);
+    v("implicit", implicit,
+      ParamInfo{"the implicit integrator's step control and linear solve (integrator implicit)"});
     v("substeps", substeps, ParamInfo{"minimum leapfrog sub-steps per step", "", 1, 10000});
     v("cfl", cfl, ParamInfo{"stability factor of the adaptive sub-step", "", 0, 2});
     v("max_substeps", max_substeps, ParamInfo{"sub-step cap", "", 1, 1000000});
@@ -135,7 +136,7 @@ struct LcpParams {
     v("friction_damping", friction_damping, ParamInfo{"friction damping d_f", "1/s", 0, 1e6});
     v("colinear_eps", colinear_eps, ParamInfo{"near-colinear threshold", "", 0, 1});
     v("body_collision", body_collision, ParamInfo{"hair-body collision"});
-    v("contact", contact);
+    v("contact", contact, ParamInfo{"hair-body contact (3.19)-(3.24)"});
     v("max_speed", max_speed,
       ParamInfo{"blow-up speed (the lcp section raises it to twice wind + shake swing + free fall)",
                 "m/s", 1e-3, 1e9});
