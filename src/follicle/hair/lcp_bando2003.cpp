@@ -705,8 +705,14 @@ double LcpSolver::stiffness_rate(const Context& ctx, const LcpState& s, LcpWorks
       [](double a, double b) { return std::max(a, b); });
   // The explicit hair-hair damping (3.17)/(3.18) needs d dt < 1 as well (per reduced mass).
   const auto& P = m_params;
-  return std::max(std::sqrt(w2),
-                  P.hair_hair ? std::max(P.collision_damping, P.friction_damping) : 0.0);
+  double rate = std::sqrt(w2) * std::max(1.0, 2 * P.spring_damping);  // damping 2 zeta omega
+  if (P.hair_hair) {
+    rate = std::max(rate, std::max(P.collision_damping, P.friction_damping));
+    rate = std::max(rate, std::sqrt(P.k_a) / m.h);  // a pressure wave crossing h (3.16)
+  }
+  rate = std::max(rate, P.air_drag);
+  if (P.body_collision && m_body) rate = std::max(rate, std::sqrt(P.contact.k_r));  // (3.24)
+  return rate;
 }
 
 void LcpSolver::tensile_moduli(const LcpWorkspace& ws, std::vector<double>& e_r,
@@ -1082,12 +1088,32 @@ LcpStepReport LcpSolver::step(const Context& ctx, const LcpStepInput& in, LcpSta
   // Sub-steps: at least params.substeps; with cfl > 0 enough that the stiffest particle's spring
   // frequency omega = sqrt(sum alpha k / m) satisfies omega dt <= cfl (explicit leapfrog).
   int nsub = P.substeps;
-  bool alpha_fresh = false;  // ws.k/ws.alpha already hold the values for the current positions
+  // ws.k/ws.alpha already hold the values for the current positions (computed with the rate).
+  const double rate = stiffness_rate(ctx, s, ws);
+  bool alpha_fresh = true;
+  // A step the leapfrog cannot take stably is refused before it starts (state untouched), with
+  // the reason: more sub-steps than max_substeps allows, or fixed sub-steps (cfl = 0) beyond
+  // omega dt <= 2.
   if (P.cfl > 0) {
-    const double rate = stiffness_rate(ctx, s, ws);
-    alpha_fresh = true;
     const double need = std::ceil(in.dt * rate / P.cfl);
-    if (std::isfinite(need)) nsub = std::max(nsub, int(std::min<double>(need, P.max_substeps)));
+    if (!(need <= P.max_substeps)) {
+      rep.ok = false;
+      rep.message = fmt::format(
+          "lcp: this step of {} s needs {} leapfrog sub-steps (stiffness rate {:.4g} 1/s, cfl "
+          "{}), more than lcp.dynamics.max_substeps = {}; raise max_substeps, lower the "
+          "stiffness or damping, or use \"integrator\": \"implicit\"",
+          in.dt, need, rate, P.cfl, P.max_substeps);
+      return rep;
+    }
+    nsub = std::max(nsub, int(need));
+  } else if (!(in.dt / nsub * rate <= 2.0)) {
+    rep.ok = false;
+    rep.message = fmt::format(
+        "lcp: fixed sub-steps of {} s (cfl = 0, substeps = {}) exceed the leapfrog's stability "
+        "limit: stiffness rate {:.4g} 1/s times the sub-step is {:.3g} > 2; set "
+        "lcp.dynamics.cfl > 0 or raise substeps",
+        in.dt / nsub, nsub, rate, in.dt / nsub * rate);
+    return rep;
   }
   const double dt = in.dt / nsub;
   const anim::RigidSample& hd = in.head;

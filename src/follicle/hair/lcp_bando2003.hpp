@@ -120,20 +120,24 @@ struct LcpParams {
     v("implicit", implicit,
       ParamInfo{"the implicit integrator's step control and linear solve (integrator implicit)"});
     v("substeps", substeps, ParamInfo{"minimum leapfrog sub-steps per step", "", 1, 10000});
-    v("cfl", cfl, ParamInfo{"stability factor of the adaptive sub-step", "", 0, 2});
+    v("cfl", cfl,
+      ParamInfo{"stability factor of the adaptive sub-step (0: exactly `substeps`, refused when "
+                "beyond the leapfrog's stability limit)",
+                "", 0, 1});
     v("max_substeps", max_substeps, ParamInfo{"sub-step cap", "", 1, 1000000});
     v("gravity", gravity, ParamInfo{"gravity", "m/s^2", -1000, 1000});
-    v("air_drag", air_drag, ParamInfo{"air drag per unit mass", "1/s", 0, 1e6});
+    v("air_drag", air_drag, ParamInfo{"air drag per unit mass", "1/s", 0, 1000});
     v("elastic_modulus", elastic_modulus, ParamInfo{"tensile modulus E", "Pa", 1e-6, 1e12});
     v("material_density", material_density, ParamInfo{"hair material density", "kg/m^3", 1, 1e5});
-    v("spring_damping", spring_damping, ParamInfo{"spring damping ratio", "", 0, 100});
+    v("spring_damping", spring_damping, ParamInfo{"spring damping ratio", "", 0, 10});
     v("compression_scale", compression_scale, ParamInfo{"compressed spring scale", "", 0, 10});
     v("alpha_sweeps", alpha_sweeps, ParamInfo{"alpha balancing sweeps", "", 0, 100});
     v("hair_hair", hair_hair, ParamInfo{"hair-hair interaction"});
-    v("k_a", k_a, ParamInfo{"pressure constant k_a", "m^2/s^2", 0, 1e6});
-    v("rho0_scale", rho0_scale, ParamInfo{"rest density rho0 / mean rest density", "", 0, 100});
-    v("collision_damping", collision_damping, ParamInfo{"collision damping d_c", "1/s", 0, 1e6});
-    v("friction_damping", friction_damping, ParamInfo{"friction damping d_f", "1/s", 0, 1e6});
+    v("k_a", k_a, ParamInfo{"pressure constant k_a (sqrt(k_a): sound speed)", "m^2/s^2", 0, 1000});
+    v("rho0_scale", rho0_scale,
+      ParamInfo{"rest density rho0 / mean rest density (< 1 repulsive, > 1 clumping)", "", 0, 1.5});
+    v("collision_damping", collision_damping, ParamInfo{"collision damping d_c", "1/s", 0, 1e4});
+    v("friction_damping", friction_damping, ParamInfo{"friction damping d_f", "1/s", 0, 1e4});
     v("colinear_eps", colinear_eps, ParamInfo{"near-colinear threshold", "", 0, 1});
     v("body_collision", body_collision, ParamInfo{"hair-body collision"});
     v("contact", contact, ParamInfo{"hair-body contact (3.19)-(3.24)"});

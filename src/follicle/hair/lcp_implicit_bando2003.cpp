@@ -320,7 +320,9 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
     // With particles in contact the sub-step also keeps them within the contact band of (3.19):
     // the velocity-level rule (3.20)-(3.24) sees a particle once per sub-step.
     const double reach = in_contact ? std::min(IP.cfl * h, P.contact.threshold) : IP.cfl * h;
-    const double allowed = v_est > 0 ? std::min(longest, reach / v_est) : longest;
+    double allowed = v_est > 0 ? std::min(longest, reach / v_est) : longest;
+    // The body's repulsion (3.24) is applied explicitly: k_r dt^2 <= 1 while in contact.
+    if (in_contact && P.contact.k_r > 0) allowed = std::min(allowed, 1 / std::sqrt(P.contact.k_r));
     int left = int(std::min<double>(std::ceil(rem / allowed * (1 - 1e-12)), 1e9));
     left = std::clamp(left, 1, std::max(1, cap - taken));
     const double dt = left == 1 ? rem : rem / left;

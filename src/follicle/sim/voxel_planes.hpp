@@ -42,7 +42,7 @@ struct BodyContactParams {
   void visit(V&& v) {
     v("threshold", threshold, ParamInfo{"contact distance", "m", 0.0, 1.0});
     v("mu", mu, ParamInfo{"Coulomb friction coefficient", "", 0.0, 10.0});
-    v("k_r", k_r, ParamInfo{"repulsion stiffness per unit mass", "1/s^2", 0.0, 1e9});
+    v("k_r", k_r, ParamInfo{"repulsion stiffness per unit mass", "1/s^2", 0.0, 1e6});
   }
   void validate() const { validate_params(*this, "body_contact"); }
 };
