@@ -72,6 +72,10 @@ TEST(CantileverPhysics, AvoidanceStaysInPlaneAndHandlesDegenerateCase) {
   EXPECT_NEAR((q - b).norm(), (p - b).norm(), 1e-9);
   const Vec3 n = (b - a).cross(p - b).normalized();
   EXPECT_NEAR((q - b).dot(n), 0.0, 1e-9);
+  // The smallest such rotation: turned back by 1e-4 rad (towards p) the point is inside.
+  const Vec3 qb = q - b, pb = p - b;
+  const Vec3 back_dir = (qb.normalized() - 1e-4 * (qb.normalized() - pb.normalized()).normalized());
+  EXPECT_LT(hull.value(b + qb.norm() * back_dir.normalized()), 0.0);
   // Degenerate: collinear points heading straight into the sphere.
   const Vec3 a2(0, 1.4, 0), b2(0, 1.1, 0), p2(0, 0.8, 0);
   const Vec3 q2 = avoid_hull_in_plane(hull, a2, b2, p2);
