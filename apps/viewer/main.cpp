@@ -1,4 +1,5 @@
-// follicle-viewer SCENE [--screenshot out.png [--frames N] [--with-ui]] [--size WxH]
+// follicle-viewer SCENE [--screenshot out.png [--frames N] [--with-ui]] [--width W --height H]
+//                 [--set PATH=VALUE ...] [--save edited.json]
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -22,7 +23,15 @@ int main(int argc, char** argv) {
   app.add_option("--width", opt.width, "window width")->check(CLI::Range(400, 16384));
   app.add_option("--height", opt.height, "window height")->check(CLI::Range(200, 16384));
   app.add_option("-j,--threads", opt.threads, "CPU threads (0 = all)")->check(CLI::Range(0, 1024));
+  app.add_option("--set", opt.sets,
+                 "edit the scene after loading, as the panel does: PATH=VALUE with a JSON path "
+                 "(hair[0].density_scale=0.5) and a JSON value (repeatable)");
+  std::string save;
+  app.add_option("--save", save,
+                 "write the (edited) scene to this JSON file, as the panel's Save does (asset "
+                 "paths made relative to its folder)");
   CLI11_PARSE(app, argc, argv);
+  opt.save = save;
   opt.scene = scene;
   opt.screenshot = screenshot;
   if (!screenshot.empty() && !screenshot.ends_with(".png") && !screenshot.ends_with(".PNG")) {

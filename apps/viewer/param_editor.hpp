@@ -169,6 +169,19 @@ class ParamEditor {
       } else {
         tooltip(info);
       }
+    } else if constexpr (requires(T & t) {
+                           t.has_value();
+                           *t;
+                           typename T::value_type;
+                         }) {
+      // std::optional of an editable struct: edited when present (absent sections are added in
+      // the scene file).
+      if (value.has_value()) {
+        ch = edit(name, *value, info);
+      } else {
+        ImGui::TextDisabled("%s (absent)", name);
+        tooltip(info);
+      }
     } else if constexpr (scene::detail::vector_of_visitable<T>::value) {
       if (ImGui::TreeNodeEx(name, ImGuiTreeNodeFlags_None, "%s (%zu)", name, value.size())) {
         tooltip(info);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "follicle/core/atomic_file.hpp"
 #include "follicle/core/context.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/log.hpp"
@@ -68,6 +69,86 @@ image::ImageRGBA8 read_pixels(int w, int h, bool opaque) {
   if (opaque)
     for (std::size_t i = 3; i < img.storage().size(); i += 4) img.storage()[i] = 255;
   return img;
+}
+
+/// "hair[0].style.length" -> the JSON pointer "/hair/0/style/length".
+std::string json_pointer_of(const std::string& path) {
+  std::string ptr, tok;
+  auto flush = [&] {
+    if (tok.empty()) fail("--set: empty key in the path '{}'", path);
+    std::string esc;
+    for (char c : tok)
+      esc += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+    ptr += "/" + esc;
+    tok.clear();
+  };
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const char c = path[i];
+    if (c == '.') {
+      flush();
+    } else if (c == '[') {
+      if (!tok.empty()) flush();
+      const std::size_t j = path.find(']', i);
+      const std::string idx = j == std::string::npos ? "" : path.substr(i + 1, j - i - 1);
+      if (idx.empty() || idx.find_first_not_of("0123456789") != std::string::npos)
+        fail("--set: expected an index [N] in the path '{}'", path);
+      ptr += "/" + idx;
+      i = j;
+      if (i + 1 < path.size() && path[i + 1] == '.') ++i;
+    } else {
+      tok += c;
+    }
+  }
+  if (!tok.empty()) flush();
+  if (ptr.empty()) fail("--set: empty path");
+  return ptr;
+}
+
+/// Applies "PATH=VALUE" to a scene's JSON: VALUE is JSON (0.5, true, [1, 2, 3], "text"), or a
+/// string when it does not parse as JSON. The section the key belongs to must exist; whether
+/// the key and the value are valid is for the scene reader to say (with the JSON path).
+void apply_set(scene::Json& j, const std::string& assignment) {
+  const std::size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    fail("--set: expected PATH=VALUE (e.g. hair[0].density_scale=0.5), got '{}'", assignment);
+  const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  scene::Json v;
+  try {
+    v = scene::Json::parse(text);
+  } catch (const std::exception&) {
+    v = text;
+  }
+  const scene::Json::json_pointer ptr(json_pointer_of(path));
+  if (!j.contains(ptr.parent_pointer()))
+    fail_at(path, "the scene has no '{}' to set a value in",
+            ptr.parent_pointer().to_string().empty() ? std::string("/")
+                                                     : ptr.parent_pointer().to_string());
+  const scene::Json& parent = j.at(ptr.parent_pointer());
+  if (parent.is_array() && !j.contains(ptr))
+    fail_at(path, "index out of range: the list has {} entries", parent.size());
+  j[ptr] = v;
+}
+
+/// Rewrites every relative string of j that names an existing file under `from` so that it
+/// names the same file from `to` (a scene saved into another folder keeps its assets).
+void rebase_paths(scene::Json& j, const std::filesystem::path& from,
+                  const std::filesystem::path& to) {
+  namespace fs = std::filesystem;
+  if (j.is_object() || j.is_array()) {
+    for (auto& e : j) rebase_paths(e, from, to);
+  } else if (j.is_string()) {
+    const std::string s = j.get<std::string>();
+    if (s.empty() || fs::path(s).is_absolute()) return;
+    std::error_code ec;
+    const fs::path file = from / s;
+    if (!fs::is_regular_file(file, ec)) return;
+    const fs::path a = fs::weakly_canonical(file), b = fs::weakly_canonical(to);
+    // Relative when the two share a folder below the root, else absolute.
+    auto ai = a.begin(), bi = b.begin();
+    int common = 0;
+    for (; ai != a.end() && bi != b.end() && *ai == *bi; ++ai, ++bi) ++common;
+    j = (common > 1 ? fs::relative(a, b) : a).generic_string();
+  }
 }
 
 double now_seconds() {
@@ -211,6 +292,7 @@ class Viewer {
                      m_error.empty() ? "nothing was rendered" : m_error);
           return 1;
         }
+        if (!m_opt.save.empty()) save_scene(m_opt.save);
         take_screenshot(m_opt.screenshot_ui ? Shot::Window : Shot::View, m_opt.screenshot);
         if (!m_error.empty()) {
           fmt::print(stderr, "follicle-viewer: {}\n", m_error);
@@ -248,12 +330,72 @@ class Viewer {
       if (m_frame_count <= 1) m_playing = false;
       m_file_camera = m_session->render_scene(0).camera;
       if (initial || camera_changed) m_orbit.set_from(m_file_camera);
+      m_edit = m_session->scene();
+      m_edit_pending = false;
       m_dirty = true;
       if (!initial) m_status = "reloaded " + m_opt.scene.filename().string();
     } catch (const std::exception& e) {
       // Keep showing the last good scene; the panel shows why the new one did not load.
       m_error = e.what();
       m_ctx.log().warn("{}", m_error);
+    }
+    if (initial && m_session && !m_opt.sets.empty()) {
+      try {
+        scene::Json j = scene::write_scene(m_session->scene());
+        for (const auto& a : m_opt.sets) apply_set(j, a);
+        if (rebuild(j)) m_status = fmt::format("{} edit(s) applied", m_opt.sets.size());
+      } catch (const std::exception& e) {
+        m_error = e.what();
+      }
+    }
+  }
+
+  /// A new session from the edited scene's JSON, through the same reader as the scene file (so
+  /// an error names the JSON path); the last good session stays when it fails. The camera stays.
+  bool rebuild(const scene::Json& j) {
+    try {
+      auto s = scene::Session::from_json(j, m_opt.scene.parent_path(),
+                                         m_opt.scene.filename().string(), m_ctx);
+      s.load_all_assets();
+      m_session.emplace(std::move(s));
+      m_frame_count = std::max(1, m_session->frame_count());
+      m_frame = std::clamp(m_frame, 0, m_frame_count - 1);
+      if (m_frame_count <= 1) m_playing = false;
+      m_edit = m_session->scene();
+      m_error.clear();
+      m_dirty = true;
+      return true;
+    } catch (const std::exception& e) {
+      m_error = e.what();
+      m_ctx.log().warn("{}", m_error);
+      return false;
+    }
+  }
+
+  /// Writes the scene as it is now (with every edit) to `path`; asset paths are made relative
+  /// to the new file's folder. `follicle validate` accepts it and `follicle render` draws the
+  /// view (tests/integration/viewer_edit_save.sh).
+  bool save_scene(const std::filesystem::path& path) {
+    namespace fs = std::filesystem;
+    try {
+      if (!m_session) fail("no scene loaded");
+      scene::Json j = scene::write_scene(m_session->scene());
+      const fs::path from = fs::absolute(m_opt.scene).parent_path();
+      const fs::path to = fs::absolute(path).parent_path();
+      // Output files stay relative to the scene (they are written next to it).
+      if (fs::weakly_canonical(from) != fs::weakly_canonical(to))
+        for (auto& [key, section] : j.items())
+          if (key != "outputs") rebase_paths(section, from, to);
+      write_file_atomically(path, j.dump(2) + "\n");
+      if (fs::weakly_canonical(path) == fs::weakly_canonical(m_opt.scene)) {
+        std::error_code ec;
+        m_mtime = fs::last_write_time(m_opt.scene, ec);  // our own write: no reload
+      }
+      m_status = "saved " + path.string();
+      return true;
+    } catch (const std::exception& e) {
+      m_error = "save: " + std::string(e.what());
+      return false;
     }
   }
 
@@ -496,6 +638,14 @@ class Viewer {
     if (ImGui::Button("Frame (F)")) frame_all();
     ImGui::SameLine();
     if (ImGui::Button("Save PNG (S)")) m_shot = Shot::View;
+    if (ImGui::Button("Save scene")) save_scene(m_opt.scene);
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("write every edit into %s", m_opt.scene.string().c_str());
+    ImGui::SameLine();
+    if (ImGui::Button("Save copy")) {
+      const auto copy = m_opt.scene.parent_path() / (m_opt.scene.stem().string() + "-edited.json");
+      save_scene(copy);
+    }
     if (!m_status.empty()) ImGui::TextDisabled("%s", m_status.c_str());
 
     ImGui::Separator();
@@ -510,6 +660,7 @@ class Viewer {
       draw_lights_panel();
       draw_render_panel();
       draw_animation_panel();
+      draw_contents_panel();
       for (auto& p : m_panels)
         if (ImGui::CollapsingHeader(p.title.c_str()) && p.draw()) m_dirty = true;
     }
@@ -518,7 +669,7 @@ class Viewer {
       ImGui::BulletText("Wheel: zoom   R: reset camera   F: frame all");
       ImGui::BulletText("S: save view PNG   Shift+S: save window PNG");
       ImGui::BulletText("Space: play/pause   Left/Right: step frame   Esc: quit");
-      ImGui::BulletText("Edits here are not saved; the scene file is reloaded when it changes.");
+      ImGui::BulletText("Save scene writes every edit; the file is reloaded when it changes.");
     }
     ImGui::PopItemWidth();
     ImGui::End();
@@ -576,6 +727,34 @@ class Viewer {
       ImGui::SetTooltip("render without supersampling while the camera moves");
   }
 
+  /// Everything else the scene file holds (hair groups and their models, skin rigs with
+  /// expressions and wrinkles, the hand, the LCP hair, the animation), edited through the same
+  /// visit() descriptions that parse the JSON. A change is applied when the widget is let go
+  /// (a slider drag re-styles or re-simulates once, not every frame): the scene is rebuilt
+  /// through the scene reader, and an invalid value is undone and reported with its JSON path.
+  void draw_contents_panel() {
+    if (ImGui::CollapsingHeader("Scene contents")) {
+      if (edit_params(m_edit, {"follicle_scene", "description", "assets", "camera", "lights",
+                               "render", "outputs"}))
+        m_edit_pending = true;
+    }
+    if (m_edit_pending && !ImGui::IsAnyItemActive()) {
+      m_edit_pending = false;
+      scene::Scene next = m_session->scene();  // lights and render settings as edited above
+      next.hair = m_edit.hair;
+      next.animation = m_edit.animation;
+      next.skin = m_edit.skin;
+      next.hand = m_edit.hand;
+      next.lcp = m_edit.lcp;
+      try {
+        if (!rebuild(scene::write_scene(next))) m_edit = m_session->scene();
+      } catch (const std::exception& e) {
+        m_error = e.what();
+        m_edit = m_session->scene();
+      }
+    }
+  }
+
   void draw_animation_panel() {
     if (m_frame_count <= 1) return;
     if (!ImGui::CollapsingHeader("Animation", ImGuiTreeNodeFlags_DefaultOpen)) return;
@@ -594,6 +773,8 @@ class Viewer {
   std::unique_ptr<render::Renderer> m_renderer;
   std::string m_device;
   std::optional<scene::Session> m_session;
+  scene::Scene m_edit;  // the panel's working copy of the scene contents
+  bool m_edit_pending = false;
   std::string m_error;   // last load/edit/render error, shown in red
   std::string m_status;  // last action (screenshot saved, reloaded)
   std::filesystem::file_time_type m_mtime{};

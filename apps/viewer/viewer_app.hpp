@@ -3,6 +3,7 @@
 // renderer, with an orbit camera and a Dear ImGui side panel. See README "Viewer".
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace follicle::viewer {
 
@@ -14,6 +15,10 @@ struct ViewerOptions {
   int width = 1280;                  // window size [screen coordinates]
   int height = 900;
   int threads = 0;  // CPU threads for scene work (0 = all)
+  // Edits applied after loading, as the panel would make them: "PATH=VALUE" with a JSON path
+  // (hair[0].density_scale) and a JSON value (a string when it does not parse as JSON).
+  std::vector<std::string> sets;
+  std::filesystem::path save;  // batch mode: write the (edited) scene here before exiting
 };
 
 /// Runs the viewer until the window closes (or the batch screenshot is written). Returns the
