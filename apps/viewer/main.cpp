@@ -30,6 +30,9 @@ int main(int argc, char** argv) {
   app.add_option("--save", save,
                  "write the (edited) scene to this JSON file, as the panel's Save does (asset "
                  "paths made relative to its folder)");
+  app.add_flag("--preview", opt.preview,
+               "draw as while the camera moves (smaller image, fewer strands; see the panel's "
+               "'preview while moving')");
   CLI11_PARSE(app, argc, argv);
   opt.save = save;
   opt.scene = scene;

@@ -21,6 +21,7 @@
 #include "follicle/core/error.hpp"
 #include "follicle/core/log.hpp"
 #include "follicle/image/image_io.hpp"
+#include "follicle/render/preview_scene.hpp"
 #include "follicle/render/renderer.hpp"
 #include "follicle/scene/session.hpp"
 #include "orbit_camera.hpp"
@@ -534,15 +535,19 @@ class Viewer {
       m_dirty = true;
     }
     if (!m_session || !(m_dirty || (m_refine && !m_moving))) return;
-    const bool fast = m_moving && m_fast_preview && !batch();
+    const bool fast = (m_moving && m_fast_preview && !batch()) || m_opt.preview;
     try {
       auto rs = m_session->render_scene(m_frame);
       rs.camera = m_orbit.camera();
       auto settings = m_session->render_settings();
       settings.width = vw;
       settings.height = vh;
-      if (fast) settings.supersample = 1;
+      // While the camera moves: a smaller image, fewer strands and particles (drawn wider), no
+      // supersampling (render::PreviewReducer); the full view follows when it stops.
+      if (fast) m_preview.reduce(rs, settings, m_preview_params);
       m_last_settings = settings;
+      m_img_w = settings.width;
+      m_img_h = settings.height;
       const double t0 = now_seconds();
       m_renderer->render_to_framebuffer(rs, settings, m_fbo);
       glFinish();  // so the time below is the real render time
@@ -572,8 +577,9 @@ class Viewer {
     glClear(GL_COLOR_BUFFER_BIT);
     if (m_has_image) {
       glBindFramebuffer(GL_READ_FRAMEBUFFER, m_fbo);
-      glBlitFramebuffer(0, 0, m_view_w, m_view_h, 0, 0, m_view_w, m_view_h, GL_COLOR_BUFFER_BIT,
-                        GL_NEAREST);
+      const bool scaled = m_img_w != m_view_w || m_img_h != m_view_h;
+      glBlitFramebuffer(0, 0, m_img_w, m_img_h, 0, 0, m_view_w, m_view_h, GL_COLOR_BUFFER_BIT,
+                        scaled ? GL_LINEAR : GL_NEAREST);
       glBindFramebuffer(GL_FRAMEBUFFER, 0);
     }
   }
@@ -594,7 +600,7 @@ class Viewer {
       if (kind == Shot::View) {
         if (!m_has_image) fail("no image rendered yet");
         glBindFramebuffer(GL_READ_FRAMEBUFFER, m_fbo);
-        img = read_pixels(m_view_w, m_view_h, true);
+        img = read_pixels(m_img_w, m_img_h, true);
       } else {
         int fb_w = 0, fb_h = 0;
         glfwGetFramebufferSize(m_window.window, &fb_w, &fb_h);
@@ -724,7 +730,23 @@ class Viewer {
     if (edit_params(m_session->scene().render, {"width", "height"})) commit_edit(before);
     ImGui::Checkbox("fast preview while moving", &m_fast_preview);
     if (ImGui::IsItemHovered())
-      ImGui::SetTooltip("render without supersampling while the camera moves");
+      ImGui::SetTooltip(
+          "while the camera moves: a smaller image, fewer strands, no supersampling; the full "
+          "view follows when it stops");
+    if (m_fast_preview && ImGui::TreeNode("preview while moving")) {
+      {
+        render::PreviewParams p = m_preview_params;
+        if (edit_params(p)) {
+          try {
+            p.validate();
+            m_preview_params = p;
+          } catch (const std::exception& e) {
+            m_error = e.what();
+          }
+        }
+      }
+      ImGui::TreePop();
+    }
   }
 
   /// Everything else the scene file holds (hair groups and their models, skin rigs with
@@ -789,6 +811,9 @@ class Viewer {
   int m_idle_frames = 0;
   unsigned m_fbo = 0, m_rb = 0;
   int m_view_w = 0, m_view_h = 0;
+  int m_img_w = 0, m_img_h = 0;  // size of the last image in m_fbo (smaller while moving)
+  render::PreviewReducer m_preview;
+  render::PreviewParams m_preview_params;
   bool m_has_image = false;
   double m_render_ms = 0;
   render::RenderSettings m_last_settings;

@@ -19,6 +19,7 @@ struct ViewerOptions {
   // (hair[0].density_scale) and a JSON value (a string when it does not parse as JSON).
   std::vector<std::string> sets;
   std::filesystem::path save;  // batch mode: write the (edited) scene here before exiting
+  bool preview = false;        // draw every frame as while the camera moves (batch checks)
 };
 
 /// Runs the viewer until the window closes (or the batch screenshot is written). Returns the

@@ -18,6 +18,7 @@ void add_lcp_workloads(std::vector<Workload>& out);
 void add_hair_render_workloads(std::vector<Workload>& out);
 void add_face_render_workloads(std::vector<Workload>& out);
 void add_daldegan_workloads(std::vector<Workload>& out);
+void add_viewer_workloads(std::vector<Workload>& out);
 
 std::vector<Workload> all_workloads() {
   std::vector<Workload> out;
@@ -31,6 +32,7 @@ std::vector<Workload> all_workloads() {
   add_hair_render_workloads(out);
   add_face_render_workloads(out);
   add_daldegan_workloads(out);
+  add_viewer_workloads(out);
   return out;
 }
 

@@ -1,0 +1,56 @@
+#pragma once
+// The reduced scene an interactive view draws while its camera moves (issue 25): a smaller image
+// (upscaled on screen), an even spread of at most `max_strands` strands and `max_particles` hair
+// particles (drawn wider, so the hair keeps its coverage), a smaller shadow map and no
+// supersampling. The full scene is drawn again as soon as the camera stops. Used by
+// follicle-viewer and the `viewer-frame` benchmark workload.
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "follicle/core/params.hpp"
+#include "follicle/render/render_scene.hpp"
+
+namespace follicle::render {
+
+struct PreviewParams {
+  double scale = 0.5;          // image size while moving / the view's size
+  int max_strands = 12000;     // strands drawn while moving (over all strand items)
+  int max_particles = 20000;   // hair particles drawn while moving (over all particle items)
+  int shadow_map_size = 1024;  // [texels] at most, while moving
+  template <class V>
+  void visit(V&& v) {
+    v("scale", scale, ParamInfo{"image size while moving / view size", "", 0.1, 1.0});
+    v("max_strands", max_strands, ParamInfo{"strands drawn while moving", "", 1, 1e8});
+    v("max_particles", max_particles, ParamInfo{"hair particles drawn while moving", "", 1, 1e8});
+    v("shadow_map_size", shadow_map_size, ParamInfo{"shadow map while moving", "", 64, 16384});
+  }
+  void validate() const { validate_params(*this, "preview"); }
+};
+
+/// Reduces scenes for the moving view; keeps the reduced strand and particle sets of the last
+/// call, so a camera move over an unchanged scene copies nothing (the sets are shared_ptrs that
+/// the scene's session keeps while they do not change).
+class PreviewReducer {
+ public:
+  /// Replaces the strand and particle sets of `rs` by reduced ones and lowers `s` (size by
+  /// p.scale, supersample 1, the shadow map to p.shadow_map_size).
+  void reduce(RenderScene& rs, RenderSettings& s, const PreviewParams& p);
+
+ private:
+  template <class T>
+  struct Entry {
+    std::weak_ptr<const T> source;
+    std::size_t keep_every = 0;
+    std::shared_ptr<const T> reduced;
+  };
+  std::vector<Entry<geom::StrandSet>> m_strands;
+  std::vector<Entry<geom::ParticleSet>> m_particles;
+};
+
+/// Every k-th strand of s (k >= 1), radii and colours kept.
+geom::StrandSet every_kth_strand(const geom::StrandSet& s, std::size_t k);
+/// Every k-th particle of s (k >= 1), radii scaled by sqrt(k).
+geom::ParticleSet every_kth_particle(const geom::ParticleSet& s, std::size_t k);
+
+}  // namespace follicle::render

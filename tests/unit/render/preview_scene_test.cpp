@@ -1,0 +1,92 @@
+// render::PreviewReducer (issue 25 item 2): the scene an interactive view draws while moving.
+#include "follicle/render/preview_scene.hpp"
+
+#include <gtest/gtest.h>
+
+#include "follicle/core/error.hpp"
+
+using namespace follicle;
+using namespace follicle::render;
+
+namespace {
+std::shared_ptr<const geom::StrandSet> strands(int n, int pts) {
+  auto s = std::make_shared<geom::StrandSet>();
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < pts; ++k) {
+      s->points.push_back(Vec3f(float(i), float(k), 0));
+      s->color.push_back(Vec3f(float(i) / n, 0, 0));
+    }
+    s->offsets.push_back(uint32_t(s->points.size()));
+  }
+  return s;
+}
+}  // namespace
+
+TEST(PreviewScene, EveryKthStrandKeepsWholeStrandsWithTheirColours) {
+  const auto s = strands(10, 4);
+  const geom::StrandSet r = every_kth_strand(*s, 3);  // strands 0, 3, 6, 9
+  ASSERT_EQ(r.num_strands(), 4u);
+  EXPECT_NO_THROW(r.check("reduced"));
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(r.strand_size(i), 4u);
+    EXPECT_EQ(r.points[r.offsets[i]].x(), float(3 * i));
+    EXPECT_EQ(r.color[r.offsets[i]].x(), float(3 * i) / 10);
+  }
+  EXPECT_EQ(every_kth_strand(*s, 1).points, s->points);
+}
+
+TEST(PreviewScene, ReduceCapsStrandsAndParticlesAndLowersTheSettings) {
+  RenderScene rs;
+  StrandItem si;
+  si.strands = strands(100000, 3);
+  rs.strands.push_back(si);
+  ParticleItem pi;
+  auto ps = std::make_shared<geom::ParticleSet>();
+  for (int i = 0; i < 50000; ++i) {
+    ps->positions.push_back(Vec3f(float(i), 0, 0));
+    ps->radius.push_back(0.001f);
+  }
+  pi.particles = ps;
+  rs.particles.push_back(pi);
+  RenderSettings s;
+  s.width = 880;
+  s.height = 800;
+  s.supersample = 2;
+  s.shadow_map_size = 4096;
+  PreviewParams p;
+  PreviewReducer red;
+  RenderScene a = rs;
+  RenderSettings sa = s;
+  red.reduce(a, sa, p);
+  EXPECT_LE(a.strands[0].strands->num_strands(), std::size_t(p.max_strands));
+  EXPECT_GE(a.strands[0].strands->num_strands(), std::size_t(p.max_strands) / 2);
+  EXPECT_GT(a.strands[0].material.width_px, rs.strands[0].material.width_px);  // drawn wider
+  EXPECT_LE(a.particles[0].particles->size(), std::size_t(p.max_particles));
+  EXPECT_EQ(sa.width, 440);
+  EXPECT_EQ(sa.height, 400);
+  EXPECT_EQ(sa.supersample, 1);
+  EXPECT_EQ(sa.shadow_map_size, p.shadow_map_size);
+  // The same source set again: the reduced set is reused, not rebuilt.
+  RenderScene b = rs;
+  RenderSettings sb = s;
+  red.reduce(b, sb, p);
+  EXPECT_EQ(a.strands[0].strands.get(), b.strands[0].strands.get());
+  // A small scene is left whole.
+  RenderScene c;
+  StrandItem small;
+  small.strands = strands(10, 3);
+  c.strands.push_back(small);
+  RenderSettings sc = s;
+  red.reduce(c, sc, p);
+  EXPECT_EQ(c.strands[0].strands.get(), small.strands.get());
+  // Bad parameters are refused with the key.
+  p.scale = 0;
+  RenderScene d = rs;
+  RenderSettings sd = s;
+  try {
+    red.reduce(d, sd, p);
+    FAIL() << "scale 0 accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("preview.scale"), std::string::npos) << e.what();
+  }
+}
