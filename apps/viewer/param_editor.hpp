@@ -30,7 +30,8 @@ namespace follicle::viewer {
 
 class ParamEditor {
  public:
-  /// `hidden`: field names not shown (e.g. width/height that the window size controls).
+  /// `hidden`: field names of the top level not shown (e.g. width/height that the window size
+  /// controls); nested structs show every field (hair[].render is not the scene's render).
   explicit ParamEditor(std::vector<std::string> hidden = {}) : m_hidden(std::move(hidden)) {}
 
   /// True when any widget changed a value since construction.
@@ -162,7 +163,7 @@ class ParamEditor {
     } else if constexpr (requires(T & t, ParamEditor & ed) { t.visit(ed); }) {
       if (ImGui::TreeNodeEx(name, ImGuiTreeNodeFlags_None)) {
         tooltip(info);
-        ParamEditor inner(m_hidden);
+        ParamEditor inner;  // `hidden` names fields of the top level only
         value.visit(inner);
         ch = inner.changed();
         ImGui::TreePop();
