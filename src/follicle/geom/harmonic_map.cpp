@@ -329,7 +329,17 @@ std::vector<Vec2> harmonic_parameterize(const TriMesh& mesh, const std::vector<V
   const auto loops = boundary_loops(mesh);
   if (loops.empty())
     fail("harmonic map: the mesh has no boundary (a closed surface needs cutting)");
-  const std::vector<int>& outer = loops.front();
+  // A boundary that touches itself (two holes meeting at a vertex, a cut through a pole) visits
+  // a vertex twice: it is fixed once, at its first visit.
+  std::vector<int> outer;
+  {
+    std::vector<char> seen(mesh.positions.size(), 0);
+    for (int v : loops.front())
+      if (!seen[std::size_t(v)]) {
+        seen[std::size_t(v)] = 1;
+        outer.push_back(v);
+      }
+  }
   if (params.circle_boundary) {
     double total = 0;
     std::vector<double> acc(outer.size(), 0.0);
