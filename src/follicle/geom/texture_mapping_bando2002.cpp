@@ -31,9 +31,9 @@ double signed_area(const Vec2& a, const Vec2& b, const Vec2& c) {
 
 // One chart: its own vertices (one per UV, so a cut splits them), faces over them, 3D positions.
 struct Chart {
-  TriMesh mesh;                     // positions per chart vertex, faces over them
-  std::vector<int> face_of;         // chart face -> input face
-  std::vector<Vec2> uv;             // per chart vertex
+  TriMesh mesh;              // positions per chart vertex, faces over them
+  std::vector<int> face_of;  // chart face -> input face
+  std::vector<Vec2> uv;      // per chart vertex
   MappingMethod method = MappingMethod::Planar;
   bool circle = false;
   Eigen::AlignedBox2d box;
@@ -128,11 +128,34 @@ void orient(Chart& ch) {
     for (auto& t : ch.uv) t.x() = -t.x();
 }
 
+// Upright charts: rotate so that the mean UV gradient of the height along `up` points along +v
+// (the face reads upright in the texture whichever way the circle boundary started).
+void make_upright(Chart& ch, const Vec3& up) {
+  Vec2 g = Vec2::Zero();
+  for (std::size_t f = 0; f < ch.mesh.faces.size(); ++f) {
+    const auto& t = ch.mesh.faces[f];
+    const Vec2 a = ch.uv[std::size_t(t[0])], e1 = ch.uv[std::size_t(t[1])] - a,
+               e2 = ch.uv[std::size_t(t[2])] - a;
+    const double h0 = ch.mesh.positions[std::size_t(t[0])].dot(up);
+    Eigen::Matrix2d E;
+    E << e1.x(), e1.y(), e2.x(), e2.y();
+    if (std::abs(E.determinant()) < 1e-300) continue;
+    const Vec2 dh(ch.mesh.positions[std::size_t(t[1])].dot(up) - h0,
+                  ch.mesh.positions[std::size_t(t[2])].dot(up) - h0);
+    const Vec2 grad = E.inverse() * dh;  // E grad = dh
+    if (grad.allFinite()) g += ch.mesh.face_area(f) * grad.normalized();
+  }
+  if (g.norm() < 1e-300) return;
+  const double turn = 0.5 * kPi - std::atan2(g.y(), g.x());
+  const double c = std::cos(turn), s = std::sin(turn);
+  for (auto& t : ch.uv) t = Vec2(c * t.x() - s * t.y(), s * t.x() + c * t.y());
+}
+
 int folded(const Chart& ch, double tiny) {
   int n = 0;
   for (const auto& f : ch.mesh.faces)
-    n += signed_area(ch.uv[std::size_t(f[0])], ch.uv[std::size_t(f[1])],
-                     ch.uv[std::size_t(f[2])]) < -tiny;
+    n += signed_area(ch.uv[std::size_t(f[0])], ch.uv[std::size_t(f[1])], ch.uv[std::size_t(f[2])]) <
+         -tiny;
   return n;
 }
 
@@ -275,9 +298,10 @@ TriMesh map_to_texture_space(const TriMesh& mesh, const TextureMappingParams& pa
         ok = harmonic_chart(ch, params, params.circle_boundary);
       }
       if (!ok)
-        fail("texture mapping: part {} ({} triangles) has no boundary even after the cylindrical "
-             "cut",
-             charts.size(), ids.size());
+        fail(
+            "texture mapping: part {} ({} triangles) has no boundary even after the cylindrical "
+            "cut",
+            charts.size(), ids.size());
       orient(ch);
       double a = 0;
       for (const auto& f : ch.mesh.faces)
@@ -294,6 +318,7 @@ TriMesh map_to_texture_space(const TriMesh& mesh, const TextureMappingParams& pa
     } else {
       orient(ch);
     }
+    make_upright(ch, up);
     charts.push_back(std::move(ch));
   }
 
@@ -368,7 +393,8 @@ TriMesh map_to_texture_space(const TriMesh& mesh, const TextureMappingParams& pa
     const Vec3i& t = mesh.faces[f];
     const Vec3i& tu = out.uv_faces[f];
     const Vec3 p0 = mesh.positions[std::size_t(t[0])];
-    const Vec3 x1 = mesh.positions[std::size_t(t[1])] - p0, x2 = mesh.positions[std::size_t(t[2])] - p0;
+    const Vec3 x1 = mesh.positions[std::size_t(t[1])] - p0,
+               x2 = mesh.positions[std::size_t(t[2])] - p0;
     const Vec3 ex = x1.normalized(), ey = (x2 - x2.dot(ex) * ex).normalized();
     Eigen::Matrix2d P, U;
     P << x1.dot(ex), x2.dot(ex), 0.0, x2.dot(ey);

@@ -39,10 +39,10 @@ struct TextureMappingParams {
   /// auto: the mesh's own UVs when it has them, otherwise per part cylindrical when the part
   /// wraps around the up axis (a head), planar when it does not (a face mask).
   MappingMethod method = MappingMethod::Auto;
-  bool harmonic = true;      // §2.4 distortion minimization (false: the projection alone)
-  Vec3 up = Vec3::UnitY();   // mesh frame: cylinder axis / planar v direction
+  bool harmonic = true;        // §2.4 distortion minimization (false: the projection alone)
+  Vec3 up = Vec3::UnitY();     // mesh frame: cylinder axis / planar v direction
   Vec3 front = Vec3::UnitZ();  // mesh frame: the face's direction (cylinder seam opposite)
-  int relax_iterations = 50;  // boundary relaxation sweeps (§2.4 "less concave")
+  int relax_iterations = 50;   // boundary relaxation sweeps (§2.4 "less concave")
   double relax_step = 0.5;
   bool circle_boundary = false;  // place every chart's boundary on a circle at once
   template <class V>
@@ -70,11 +70,11 @@ struct TextureMappingReport {
   MappingMethod method = MappingMethod::Uv;  // what was used (planar/cylindrical: of the largest)
   int charts = 0;                            // connected parts mapped
   int planar_charts = 0, cylindrical_charts = 0;
-  int circle_charts = 0;      // charts whose boundary went on a circle (the fold fallback)
-  int flipped = 0;            // UV triangles with opposite orientation (0 for a harmonic map)
-  int degenerate = 0;         // zero-area UV triangles
-  double stretch_mean = 0;    // area-weighted mean singular-value ratio of the 3D -> UV map
-  double stretched_area = 0;  // share of the 3D area stretched more than 4:1
+  int circle_charts = 0;       // charts whose boundary went on a circle (the fold fallback)
+  int flipped = 0;             // UV triangles with opposite orientation (0 for a harmonic map)
+  int degenerate = 0;          // zero-area UV triangles
+  double stretch_mean = 0;     // area-weighted mean singular-value ratio of the 3D -> UV map
+  double stretched_area = 0;   // share of the 3D area stretched more than 4:1
   double metres_per_unit = 0;  // texture scale of the packed charts
   std::string summary() const;
 };

@@ -1,11 +1,10 @@
-#include "follicle/geom/texture_mapping_bando2002.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "follicle/core/error.hpp"
 #include "follicle/geom/mesh_io.hpp"
+#include "follicle/geom/texture_mapping_bando2002.hpp"
 #include "testing/testing.hpp"
 
 using namespace follicle;
@@ -152,8 +151,8 @@ TEST(TextureMapping, ProjectionAloneAndBadInput) {
 }
 
 TEST(TextureMapping, MeshWithUvsKeepsThemUnderAuto) {
-  const TriMesh head = load_mesh(test::source_dir() / "data/meshes/lee_perry_smith/head.obj",
-                                 LengthUnit::mm);
+  const TriMesh head =
+      load_mesh(test::source_dir() / "data/meshes/lee_perry_smith/head.obj", LengthUnit::mm);
   TextureMappingReport rep;
   const TriMesh m = map_to_texture_space(head, {}, &rep);
   EXPECT_EQ(rep.method, MappingMethod::Uv);
@@ -163,8 +162,8 @@ TEST(TextureMapping, MeshWithUvsKeepsThemUnderAuto) {
 // The bundled head without its UVs, as a scan would come: one chart, no folds, in any rigid
 // orientation and mirrored when up and front say where the head looks.
 TEST(TextureMapping, HeadScanWithoutUvsInAnyOrientation) {
-  const TriMesh head = strip_uvs(load_mesh(
-      test::source_dir() / "data/meshes/lee_perry_smith/head.obj", LengthUnit::mm));
+  const TriMesh head = strip_uvs(
+      load_mesh(test::source_dir() / "data/meshes/lee_perry_smith/head.obj", LengthUnit::mm));
   const Eigen::AngleAxisd rot(1.1, Vec3(0.3, 0.8, -0.5).normalized());
   for (int variant = 0; variant < 3; ++variant) {
     TriMesh m = head;
@@ -186,12 +185,26 @@ TEST(TextureMapping, HeadScanWithoutUvsInAnyOrientation) {
     EXPECT_LE(rep.degenerate, 3) << rep.summary();
     EXPECT_LT(rep.stretched_area, 0.05) << rep.summary();
     expect_in_unit_square(out);
+    // Upright: the chin (lowest point along up) lies below the forehead's top in v.
+    const Vec3 upv = p.up.normalized();
+    std::size_t lo = 0, hi = 0;
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+      const Vec3 d = m.positions[v];
+      if (d.dot(upv) < m.positions[lo].dot(upv)) lo = v;
+      if (d.dot(upv) > m.positions[hi].dot(upv)) hi = v;
+    }
+    auto uv_of = [&](std::size_t v) {
+      for (std::size_t f = 0; f < out.faces.size(); ++f)
+        for (int c = 0; c < 3; ++c)
+          if (std::size_t(out.faces[f][c]) == v) return out.uvs[std::size_t(out.uv_faces[f][c])];
+      return Vec2(0, 0);
+    };
+    EXPECT_LT(uv_of(lo).y(), uv_of(hi).y());
   }
 }
 
 TEST(TextureMapping, SintelBustHasNoUvsAndMapsWithoutFolds) {
-  const TriMesh m =
-      load_mesh(test::source_dir() / "data/meshes/sintel/sintel.obj", LengthUnit::m);
+  const TriMesh m = load_mesh(test::source_dir() / "data/meshes/sintel/sintel.obj", LengthUnit::m);
   ASSERT_FALSE(m.has_uvs());
   TextureMappingReport rep;
   const TriMesh out = map_to_texture_space(m, {}, &rep);
