@@ -13,7 +13,11 @@
 // (eyes, mouth) are closed by virtual fans while solving so that the solve is a Tutte embedding;
 // when the relaxed boundary still leaves folded triangles, the chart's boundary is placed on a
 // circle by arc length (Eck/Floater: a convex boundary and positive weights cannot fold). Charts
-// are scaled to one texel density (metres per texture unit) and packed into [0,1]^2.
+// are scaled to one texel density (metres per texture unit) and packed into [0,1]^2, each turned
+// so that `up` reads upwards in v.
+// Measured: on whole heads (the bundled scan, Sintel, ICT) the relaxed cylindrical boundary still
+// folds near the crown, so their head chart takes the circle boundary (conformal, fold-free, but
+// the face gets a smaller share of the texture than a cylinder would give it).
 #include <array>
 #include <string>
 #include <utility>
