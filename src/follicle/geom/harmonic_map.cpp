@@ -181,6 +181,21 @@ std::vector<Vec2> per_vertex_uvs(const TriMesh& mesh, double tolerance) {
   return uv;
 }
 
+double uv_stretch(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec2& t0, const Vec2& t1,
+                  const Vec2& t2) {
+  // Jacobian of the affine map from the triangle's 3D frame to UV.
+  const Vec3 x1 = p1 - p0, x2 = p2 - p0;
+  const Vec3 ex = x1.normalized();
+  const Vec3 ey = (x2 - x2.dot(ex) * ex).normalized();
+  Eigen::Matrix2d P, U;
+  P << x1.dot(ex), x2.dot(ex), 0.0, x2.dot(ey);
+  U.col(0) = t1 - t0;
+  U.col(1) = t2 - t0;
+  const Eigen::JacobiSVD<Eigen::Matrix2d> svd(U * P.inverse());
+  const double s0 = svd.singularValues()[0], s1 = svd.singularValues()[1];
+  return s1 > 0 ? s0 / s1 : std::numeric_limits<double>::infinity();
+}
+
 UvQuality evaluate_uv_quality(const TriMesh& mesh, const std::vector<Vec2>& uv) {
   UvQuality q;
   if (uv.size() != mesh.positions.size())
@@ -209,21 +224,11 @@ UvQuality evaluate_uv_quality(const TriMesh& mesh, const std::vector<Vec2>& uv) 
     }
     if (s < 0) ++q.flipped;
     if (a3[f] <= 0) continue;
-    // Jacobian of the affine map from the triangle's 3D frame to UV.
     const Vec3i& t = mesh.faces[f];
-    const Vec3 p0 = mesh.positions[std::size_t(t[0])];
-    const Vec3 x1 = mesh.positions[std::size_t(t[1])] - p0,
-               x2 = mesh.positions[std::size_t(t[2])] - p0;
-    const Vec3 ex = x1.normalized();
-    const Vec3 ey = (x2 - x2.dot(ex) * ex).normalized();
-    Eigen::Matrix2d P, U;
-    P << x1.dot(ex), x2.dot(ex), 0.0, x2.dot(ey);
-    U.col(0) = uv[std::size_t(t[1])] - uv[std::size_t(t[0])];
-    U.col(1) = uv[std::size_t(t[2])] - uv[std::size_t(t[0])];
-    const Eigen::Matrix2d J = U * P.inverse();
-    Eigen::JacobiSVD<Eigen::Matrix2d> svd(J);
-    const double s0 = svd.singularValues()[0], s1 = svd.singularValues()[1];
-    const double stretch = s1 > 0 ? s0 / s1 : std::numeric_limits<double>::infinity();
+    const double stretch =
+        uv_stretch(mesh.positions[std::size_t(t[0])], mesh.positions[std::size_t(t[1])],
+                   mesh.positions[std::size_t(t[2])], uv[std::size_t(t[0])], uv[std::size_t(t[1])],
+                   uv[std::size_t(t[2])]);
     q.stretch_mean += a3[f] * stretch;
     q.stretch_max = std::max(q.stretch_max, stretch);
     q.area_distortion += a3[f] * std::abs(std::log(std::abs(sa[f]) / a3[f] / global));

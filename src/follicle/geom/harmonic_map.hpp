@@ -61,6 +61,11 @@ struct UvQuality {
 };
 UvQuality evaluate_uv_quality(const TriMesh& mesh, const std::vector<Vec2>& vertex_uv);
 
+/// sigma_max / sigma_min of the affine map from triangle (p0, p1, p2) to UV triangle (t0, t1, t2);
+/// infinity when the UV triangle is degenerate.
+double uv_stretch(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec2& t0, const Vec2& t1,
+                  const Vec2& t2);
+
 /// Ordered boundary loops (vertex indices), longest (3D length) first.
 std::vector<std::vector<int>> boundary_loops(const TriMesh& mesh);
 

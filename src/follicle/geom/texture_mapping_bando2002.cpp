@@ -151,6 +151,14 @@ void make_upright(Chart& ch, const Vec3& up) {
   for (auto& t : ch.uv) t = Vec2(c * t.x() - s * t.y(), s * t.x() + c * t.y());
 }
 
+double uv_area(const Chart& ch) {
+  double a = 0;
+  for (const auto& f : ch.mesh.faces)
+    a += std::abs(
+        signed_area(ch.uv[std::size_t(f[0])], ch.uv[std::size_t(f[1])], ch.uv[std::size_t(f[2])]));
+  return a;
+}
+
 int folded(const Chart& ch, double tiny) {
   int n = 0;
   for (const auto& f : ch.mesh.faces)
@@ -303,13 +311,8 @@ TriMesh map_to_texture_space(const TriMesh& mesh, const TextureMappingParams& pa
             "cut",
             charts.size(), ids.size());
       orient(ch);
-      double a = 0;
-      for (const auto& f : ch.mesh.faces)
-        a += std::abs(signed_area(ch.uv[std::size_t(f[0])], ch.uv[std::size_t(f[1])],
-                                  ch.uv[std::size_t(f[2])]));
-      if (!ch.circle && folded(ch, 1e-14 * a) > 0) {
+      if (!ch.circle && folded(ch, 1e-14 * uv_area(ch)) > 0) {
         // The relaxed projection still folds: a convex (circle) boundary cannot (Tutte).
-        ch.uv.clear();
         Chart again = build(ch.method);
         harmonic_chart(again, params, true);
         ch = std::move(again);
@@ -325,13 +328,9 @@ TriMesh map_to_texture_space(const TriMesh& mesh, const TextureMappingParams& pa
   // One texel density: each chart in metres (its 3D area over its UV area), then shelf-packed.
   double box_area = 0;
   for (auto& ch : charts) {
-    double a3 = 0, auv = 0;
-    for (std::size_t f = 0; f < ch.mesh.faces.size(); ++f) {
-      const auto& t = ch.mesh.faces[f];
-      a3 += ch.mesh.face_area(f);
-      auv += std::abs(signed_area(ch.uv[std::size_t(t[0])], ch.uv[std::size_t(t[1])],
-                                  ch.uv[std::size_t(t[2])]));
-    }
+    double a3 = 0;
+    for (std::size_t f = 0; f < ch.mesh.faces.size(); ++f) a3 += ch.mesh.face_area(f);
+    const double auv = uv_area(ch);
     const double k = auv > 0 && a3 > 0 ? std::sqrt(a3 / auv) : 1.0;
     ch.box.setEmpty();
     for (auto& t : ch.uv) {
@@ -392,18 +391,12 @@ TriMesh map_to_texture_space(const TriMesh& mesh, const TextureMappingParams& pa
     if (!(a3 > 1e-9 * a3_total)) continue;
     const Vec3i& t = mesh.faces[f];
     const Vec3i& tu = out.uv_faces[f];
-    const Vec3 p0 = mesh.positions[std::size_t(t[0])];
-    const Vec3 x1 = mesh.positions[std::size_t(t[1])] - p0,
-               x2 = mesh.positions[std::size_t(t[2])] - p0;
-    const Vec3 ex = x1.normalized(), ey = (x2 - x2.dot(ex) * ex).normalized();
-    Eigen::Matrix2d P, U;
-    P << x1.dot(ex), x2.dot(ex), 0.0, x2.dot(ey);
-    U.col(0) = out.uvs[std::size_t(tu[1])] - out.uvs[std::size_t(tu[0])];
-    U.col(1) = out.uvs[std::size_t(tu[2])] - out.uvs[std::size_t(tu[0])];
-    const Eigen::JacobiSVD<Eigen::Matrix2d> svd(U * P.inverse());
-    const double s0 = svd.singularValues()[0], s1 = svd.singularValues()[1];
     // Capped so that one crushed sliver cannot stand for the whole map in the mean.
-    const double st = s1 > 0 ? std::min(s0 / s1, 1e3) : 1e3;
+    const double st =
+        std::min(uv_stretch(mesh.positions[std::size_t(t[0])], mesh.positions[std::size_t(t[1])],
+                            mesh.positions[std::size_t(t[2])], out.uvs[std::size_t(tu[0])],
+                            out.uvs[std::size_t(tu[1])], out.uvs[std::size_t(tu[2])]),
+                 1e3);
     rep.stretch_mean += a3 * st;
     wsum += a3;
     if (st > 4) rep.stretched_area += a3;
