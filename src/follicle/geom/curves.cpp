@@ -213,6 +213,71 @@ auto CatmullRom<D>::sample(std::size_t per_segment) const -> std::vector<V> {
   return out;
 }
 
+template <int D>
+CubicBezier<D> fit_cubic_bezier(const std::vector<Eigen::Matrix<double, D, 1>>& points) {
+  using V = Eigen::Matrix<double, D, 1>;
+  const std::size_t n = points.size();
+  if (n < 2) fail("fit_cubic_bezier: {} point(s), need at least 2", n);
+  for (const V& q : points)
+    if (!q.allFinite()) fail("fit_cubic_bezier: a point is not finite");
+  CubicBezier<D> c;
+  c.p[0] = points.front();
+  c.p[3] = points.back();
+  const V chord = c.p[3] - c.p[0];
+  c.p[1] = c.p[0] + chord / 3.0;
+  c.p[2] = c.p[0] + 2.0 * chord / 3.0;
+  if (n == 2) return c;
+  // Chord-length parameters t_i in [0, 1].
+  std::vector<double> t(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i) t[i] = t[i - 1] + (points[i] - points[i - 1]).norm();
+  const double total = t.back();
+  if (!(total > 0)) return c;  // every point the same: a point curve
+  for (double& x : t) x /= total;
+  // Minimize sum |B(t_i) - q_i|^2 over the free p1, p2 (D independent 2x2 systems sharing one
+  // matrix): B = b0 p0 + b1 p1 + b2 p2 + b3 p3. Then Schneider's reparameterization: each t_i
+  // moves to the parameter of the fitted curve's point closest to q_i, and the fit is redone;
+  // points sampled from a cubic are reproduced once the parameters have converged.
+  auto solve = [&](CubicBezier<D>& cur) {
+    Eigen::Matrix2d a = Eigen::Matrix2d::Zero();
+    Eigen::Matrix<double, 2, D> rhs = Eigen::Matrix<double, 2, D>::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double u = t[i], s = 1 - u;
+      const double b0 = s * s * s, b1 = 3 * s * s * u, b2 = 3 * s * u * u, b3 = u * u * u;
+      a(0, 0) += b1 * b1;
+      a(0, 1) += b1 * b2;
+      a(1, 1) += b2 * b2;
+      const V r = points[i] - b0 * cur.p[0] - b3 * cur.p[3];
+      rhs.row(0) += b1 * r.transpose();
+      rhs.row(1) += b2 * r.transpose();
+    }
+    a(1, 0) = a(0, 1);
+    if (!(std::abs(a.determinant()) > 1e-12 * a.squaredNorm())) return false;
+    const Eigen::Matrix<double, 2, D> x = a.inverse() * rhs;
+    cur.p[1] = x.row(0).transpose();
+    cur.p[2] = x.row(1).transpose();
+    return cur.p[1].allFinite() && cur.p[2].allFinite();
+  };
+  CubicBezier<D> cur = c;
+  if (!solve(cur)) return c;  // all points at the ends
+  constexpr int kReparameterizations = 20;
+  for (int it = 0; it < kReparameterizations; ++it) {
+    double moved = 0;
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+      const double nt = cur.closest_parameter(points[i]);
+      moved = std::max(moved, std::abs(nt - t[i]));
+      t[i] = nt;
+    }
+    CubicBezier<D> next = cur;
+    if (!solve(next)) break;
+    cur = next;
+    if (moved < 1e-12) break;
+  }
+  return cur;
+}
+
+template CubicBezier<2> fit_cubic_bezier<2>(const std::vector<Vec2>&);
+template CubicBezier<3> fit_cubic_bezier<3>(const std::vector<Vec3>&);
+
 template struct CubicBezier<2>;
 template struct CubicBezier<3>;
 template class CatmullRom<2>;

@@ -35,6 +35,15 @@ struct CubicBezier {
 using Bezier2 = CubicBezier<2>;
 using Bezier3 = CubicBezier<3>;
 
+/// The cubic Bézier through the first and last of `points` that is closest to the others in the
+/// least-squares sense, at chord-length parameters (Schneider, "An algorithm for automatically
+/// fitting digitized curves", Graphics Gems 1990: the two inner control points from the 2x2
+/// normal equations). Two points give the straight segment; near-collinear or degenerate inner
+/// systems fall back to the chord's thirds. Throws follicle::Error for fewer than 2 points or
+/// non-finite ones.
+template <int D>
+CubicBezier<D> fit_cubic_bezier(const std::vector<Eigen::Matrix<double, D, 1>>& points);
+
 /// Catmull-Rom spline through points. alpha = 0: uniform, 0.5: centripetal (no cusps or
 /// self-intersections within a segment, Yuksel et al. 2011), 1: chordal. The curve interpolates
 /// every point; parameter s runs over [0, num_segments()], segment i spans [i, i+1].

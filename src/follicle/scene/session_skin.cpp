@@ -10,12 +10,15 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/log.hpp"
+#include "follicle/geom/spatial_embree.hpp"
+#include "follicle/geom/uv_locator.hpp"
 #include "follicle/image/image_io.hpp"
 #include "follicle/render/lafortune.hpp"
 #include "follicle/scene/session.hpp"
 #include "follicle/scene/skin_runtime.hpp"
 #include "follicle/skin/setup_fit.hpp"
 #include "follicle/skin/skin_color_bando2002.hpp"
+#include "follicle/skin/wrinkle_transfer.hpp"
 
 namespace follicle::scene {
 
@@ -69,41 +72,127 @@ skin::MusclePose resolve_pose(const skin::MuscleSet& set, const std::string& exp
   return pose;
 }
 
-// Direction keys of one fine-wrinkle field on the uv vertices of `base`; a "uv" key goes to the
-// nearest uv vertex used by a face. Errors name the JSON path.
-std::vector<skin::DirectionKey> fine_keys(const geom::TriMesh& base,
+// Direction keys of one fine-wrinkle field on the uv vertices of the rig's base mesh `base`.
+// `asset` is the mesh asset (the same surface; `remapped`: base has a texture layout of its own,
+// skin[].mapping). A key in the asset's own layout on an unchanged layout is taken as it is ("uv":
+// the nearest uv vertex used by a face); anything else goes through the surface: the key's face
+// and barycentric weights, its direction as a surface tangent (J_asset d, or the given tangent),
+// then the base layout's uv vertex of the nearest corner and J_base^+ t scaled to the key's
+// magnitude. Errors name the JSON path.
+std::vector<skin::DirectionKey> fine_keys(const geom::TriMesh& base, const geom::TriMesh& asset,
+                                          bool remapped,
                                           const std::vector<FineDirectionKeySpec>& keys,
                                           const JsonSource& src, const std::string& path) {
   std::vector<char> used(base.uvs.size(), 0);
   for (const auto& f : base.uv_faces)
     for (int c = 0; c < 3; ++c)
       if (f[c] >= 0 && std::size_t(f[c]) < used.size()) used[std::size_t(f[c])] = 1;
+  std::unique_ptr<geom::MeshQuery> query;
+  std::unique_ptr<geom::UvLocator> own;
   std::vector<skin::DirectionKey> out;
   for (std::size_t k = 0; k < keys.size(); ++k) {
     const auto& key = keys[k];
     const std::string at = index_path(path, k);
-    int v = -1;
-    if (key.vertex) {
-      v = *key.vertex;
-      if (v < 0 || std::size_t(v) >= base.uvs.size())
-        json_fail(src, at + ".vertex",
-                  fmt::format("uv vertex {} out of range: the mesh has {} uv vertices", v,
-                              base.uvs.size()));
-    } else if (key.uv) {
-      double best = 1e300;
-      for (std::size_t t = 0; t < base.uvs.size(); ++t) {
-        if (!used[t]) continue;
-        const double d = (base.uvs[t] - *key.uv).squaredNorm();
-        if (d < best) {
-          best = d;
-          v = int(t);
+    if (key.vertex && !(*key.vertex >= 0 && std::size_t(*key.vertex) < asset.uvs.size()))
+      json_fail(src, at + ".vertex",
+                fmt::format("uv vertex {} out of range: the mesh has {} uv vertices", *key.vertex,
+                            asset.uvs.size()));
+    if ((key.vertex || key.uv || key.direction) && !asset.has_uvs())
+      json_fail(src, at,
+                "the mesh has no texture coordinates of its own: give the key as \"point\" (on "
+                "the skin) with a \"tangent\"");
+    if (!remapped && !key.point && key.direction) {
+      int v = -1;
+      if (key.vertex) {
+        v = *key.vertex;
+      } else {
+        double best = 1e300;
+        for (std::size_t t = 0; t < base.uvs.size(); ++t) {
+          if (!used[t]) continue;
+          const double d = (base.uvs[t] - *key.uv).squaredNorm();
+          if (d < best) {
+            best = d;
+            v = int(t);
+          }
         }
+        if (v < 0) json_fail(src, at + ".uv", "the mesh has no texture coordinates");
       }
-      if (v < 0) json_fail(src, at + ".uv", "the mesh has no texture coordinates");
+      out.push_back({v, *key.direction});
+      continue;
     }
-    out.push_back({v, key.direction});
+    // Where on the surface: a face and barycentric weights (the same faces on asset and base).
+    int face = -1;
+    Vec3 bary = Vec3::Zero();
+    if (key.point) {
+      if (!query) query = std::make_unique<geom::MeshQuery>(base);
+      const auto cp = query->closest_point(*key.point);
+      if (cp.face < 0 || !(cp.distance <= skin::kMuscleTolerance))
+        json_fail(src, at + ".point",
+                  fmt::format("lies {:.1f} mm from the skin (at most {:.0f} mm): points are metres "
+                              "in the mesh's frame",
+                              1e3 * cp.distance, 1e3 * skin::kMuscleTolerance));
+      face = cp.face;
+      bary = cp.bary;
+    } else {
+      if (!own) own = std::make_unique<geom::UvLocator>(asset);
+      const Vec2 q = key.vertex ? asset.uvs[std::size_t(*key.vertex)] : *key.uv;
+      const auto hit = own->locate(q, 1e-6);
+      if (hit.face < 0)
+        json_fail(src, at + (key.vertex ? ".vertex" : ".uv"),
+                  fmt::format("({:.4f}, {:.4f}) lies on no triangle of the mesh's own texture "
+                              "layout, so it cannot be carried to the rig's layout",
+                              q.x(), q.y()));
+      face = hit.face;
+      bary = hit.bary;
+    }
+    const auto f = std::size_t(face);
+    Vec3 t;
+    double m;
+    if (key.tangent) {
+      t = *key.tangent;
+      m = t.norm();
+    } else {
+      t = geom::uv_jacobian(asset, f) * *key.direction;
+      m = key.direction->norm();
+    }
+    Vec2 d = Vec2::Zero();
+    if (m > 0) {
+      const Eigen::Matrix<double, 3, 2> jb = geom::uv_jacobian(base, f);
+      d = (jb.transpose() * jb).ldlt().solve(jb.transpose() * t);
+      if (!(d.allFinite() && d.norm() > 1e-12 * t.norm()))
+        json_fail(src, at + (key.tangent ? ".tangent" : ".direction"),
+                  "the direction lies along the skin's normal there (no direction on the skin)");
+      d = d.normalized() * m;
+    }
+    int corner = 0;
+    bary.maxCoeff(&corner);
+    out.push_back({base.uv_faces[f][corner], d});
   }
   return out;
+}
+
+// The rig's base mesh: the mesh asset, or the asset in a texture space of its own (Bando 2002
+// §2.4) when skin[].mapping asks for one or the asset has no UVs.
+std::shared_ptr<const geom::TriMesh> rig_base_mesh(std::shared_ptr<const geom::TriMesh> asset,
+                                                   const geom::TextureMappingParams& mapping,
+                                                   const std::string& where, spdlog::logger& log) {
+  using geom::MappingMethod;
+  if (mapping.method == MappingMethod::Uv && !asset->has_uvs())
+    fail(
+        "{}: mapping.method \"uv\" but the mesh has no texture coordinates; use \"auto\", "
+        "\"planar\" or \"cylindrical\" (Bando 2002 §2.4)",
+        where);
+  if (mapping.method == MappingMethod::Uv ||
+      (mapping.method == MappingMethod::Auto && asset->has_uvs()))
+    return asset;
+  geom::TextureMappingReport rep;
+  auto mapped = std::make_shared<geom::TriMesh>(geom::map_to_texture_space(*asset, mapping, &rep));
+  log.info("{}: texture space ({}): {}", where,
+           asset->has_uvs() ? "replacing the mesh's UVs" : "the mesh has no UVs", rep.summary());
+  if (rep.flipped > 0)
+    log.warn("{}: the texture mapping folds {} triangles over (wrinkles there may be misplaced)",
+             where, rep.flipped);
+  return mapped;
 }
 
 }  // namespace
@@ -140,33 +229,54 @@ void Session::resolve_skin(std::size_t ri) {
   const std::string file = resolve(s.muscles).string();
   skin::FaceSetup setup = skin::load_face_setup(file);  // errors name the setup file and path
   // Wrinkle edits: r for every wrinkle, then per-wrinkle overrides, then extra wrinkles.
-  if (s.wrinkle_r)
+  if (s.wrinkle_r) {
     for (auto& w : setup.wrinkles) w.r = *s.wrinkle_r;
+    for (auto& w : setup.surface_wrinkles) w.r = *s.wrinkle_r;
+  }
   for (std::size_t k = 0; k < s.wrinkle_overrides.size(); ++k) {
     const auto& o = s.wrinkle_overrides[k];
     const std::string op = index_path(p + ".wrinkle_overrides", k);
     skin::LargeWrinkle* w = nullptr;
+    skin::SurfaceWrinkle* sw = nullptr;
     std::vector<std::string> names;
     for (auto& x : setup.wrinkles) {
       if (x.name == o.name) w = &x;
       names.push_back(x.name);
     }
-    if (!w) {
+    for (auto& x : setup.surface_wrinkles) {
+      if (x.name == o.name) sw = &x;
+      names.push_back(x.name);
+    }
+    if (!w && !sw) {
       const std::string hint = suggest(o.name, names);
       json_fail(src, op + ".name",
                 "no wrinkle named \"" + o.name + "\" in " + file +
                     (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)"));
     }
-    if (o.depth) w->depth = *o.depth;
-    if (o.width) w->width = *o.width;
-    if (o.r) w->r = *o.r;
-    if (o.end_taper) w->end_taper = *o.end_taper;
-    if (o.p0) w->control[0] = *o.p0;
-    if (o.p1) w->control[1] = *o.p1;
-    if (o.p2) w->control[2] = *o.p2;
-    if (o.p3) w->control[3] = *o.p3;
+    if (w) {
+      if (o.depth) w->depth = *o.depth;
+      if (o.width) w->width = *o.width;
+      if (o.r) w->r = *o.r;
+      if (o.end_taper) w->end_taper = *o.end_taper;
+      if (o.p0) w->control[0] = *o.p0;
+      if (o.p1) w->control[1] = *o.p1;
+      if (o.p2) w->control[2] = *o.p2;
+      if (o.p3) w->control[3] = *o.p3;
+    } else {
+      if (o.p0 || o.p1 || o.p2 || o.p3)
+        json_fail(src, op,
+                  "\"" + o.name +
+                      "\" is a surface wrinkle: its shape is its points on the skin, not Bezier "
+                      "control points (edit depth, width, r, end_taper, or add the changed "
+                      "wrinkle with add_surface_wrinkles)");
+      if (o.depth) sw->depth = *o.depth;
+      if (o.width) sw->width = *o.width;
+      if (o.r) sw->r = *o.r;
+      if (o.end_taper) sw->end_taper = *o.end_taper;
+    }
   }
   for (const auto& w : s.add_wrinkles) setup.wrinkles.push_back(w);
+  for (const auto& w : s.add_surface_wrinkles) setup.surface_wrinkles.push_back(w);
   // Poses: the still expression and the track keys (checked against the muscle set).
   r.static_pose = resolve_pose(setup.muscles, s.expression, s.weight, s.contractions, s.jaw_angle,
                                src, p, file);
@@ -202,14 +312,46 @@ const skin::FaceRig& Session::face_rig(std::size_t ri) {
   if (r.rig) return *r.rig;
   const SkinSpec& s = m_scene.skin[ri];
   const std::string where = fmt::format("{}: skin[{}] (mesh \"{}\")", m_source, ri, s.mesh);
-  const auto base = mesh(mesh_index(s.mesh));
-  if (base->uvs.empty())
-    fail("{}: the mesh has no texture coordinates; the wrinkles live in texture space", where);
+  const auto asset = mesh(mesh_index(s.mesh));
+  r.base = rig_base_mesh(asset, s.mapping, where, m_ctx->log());
+  const geom::TriMesh& base = *r.base;
+  const bool remapped = r.base != asset;
+  if (remapped && !s.tissue.thickness_map.empty())
+    fail(
+        "{}: tissue.thickness_map is painted in the mesh's own texture space, and the rig maps "
+        "the mesh anew ({}): drop the map, or give the mesh UVs and mapping \"uv\"",
+        where, asset->has_uvs() ? "skin[].mapping" : "the mesh has no UVs");
+  // The wrinkles in the rig's texture space: the setup's curves (in the texture space of the
+  // mesh asset's own layout) carried to a new layout through the surface, and the surface
+  // wrinkles placed on it.
+  // With "wrinkles": false they are placed all the same (the refinement around them is the same
+  // mesh), only not applied; curves that cannot be placed are then left out instead of refused.
+  r.wrinkles.clear();
+  try {
+    if (!remapped) {
+      r.wrinkles = r.setup.wrinkles;
+    } else if (!r.setup.wrinkles.empty() && asset->has_uvs()) {
+      r.wrinkles = skin::carry_wrinkles(*asset, base, r.setup.wrinkles, where);
+    } else if (!r.setup.wrinkles.empty() && s.wrinkles) {
+      fail(
+          "{}: the face-setup file's {} wrinkles are Bezier curves in the texture space of the "
+          "head it was made for, and this mesh has no texture coordinates: give them as "
+          "\"surface_wrinkles\" (points on the skin, metres) in the setup or as "
+          "skin[].add_surface_wrinkles, or set \"wrinkles\": false",
+          where, r.setup.wrinkles.size());
+    }
+    const auto placed = skin::place_surface_wrinkles(base, r.setup.surface_wrinkles, where);
+    r.wrinkles.insert(r.wrinkles.end(), placed.begin(), placed.end());
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    if (what.rfind(where, 0) == 0) throw;
+    fail("{}: {}", where, what);
+  }
   // A setup made for another head or unit would deform nothing where it should and show no
   // wrinkles, silently: measured and refused or warned with numbers (skin/setup_fit).
   {
     const auto fit = skin::measure_setup_fit(
-        *base, r.setup.muscles, s.wrinkles ? r.setup.wrinkles : std::vector<skin::LargeWrinkle>{});
+        base, r.setup.muscles, s.wrinkles ? r.wrinkles : std::vector<skin::LargeWrinkle>{});
     for (const auto& w : skin::judge_setup_fit(fit, where)) m_ctx->log().warn("{}: {}", where, w);
   }
   skin::FaceRigParams fp;
@@ -221,13 +363,13 @@ const skin::FaceRig& Session::face_rig(std::size_t ri) {
     thickness = image::read_gray_map(resolve(s.tissue.thickness_map));
   }
   try {
-    r.rig = std::make_unique<skin::FaceRig>(*base, r.setup.muscles, r.setup.wrinkles, fp,
+    r.rig = std::make_unique<skin::FaceRig>(base, r.setup.muscles, r.wrinkles, fp,
                                             thickness ? &*thickness : nullptr);
   } catch (const Error& e) {
     fail("{}: {}", where, e.what());
   }
   m_ctx->log().info("{}: face rig with {} muscles, {} wrinkles, {} vertices after refinement",
-                    where, r.setup.muscles.num_muscles(), r.setup.wrinkles.size(),
+                    where, r.setup.muscles.num_muscles(), r.wrinkles.size(),
                     r.rig->rest_mesh().positions.size());
   if (s.albedo == SkinAlbedo::SkinColor) {
     const auto c = skin::skin_vertex_colors(s.color.resolve(), r.rig->rest_mesh().positions.size());
@@ -360,20 +502,23 @@ std::shared_ptr<const image::ImageF> Session::skin_fine_relief(std::size_t ri, i
     // §2.6.1-2.6.2 once per rig, on the base mesh (the mesh asset the FaceRig refines).
     const JsonSource src{m_source};
     const std::string p = index_path("skin", ri) + ".fine";
-    const auto base = mesh(mesh_index(s.mesh));
+    (void)face_rig(ri);
+    const auto asset = mesh(mesh_index(s.mesh));
+    const auto& base = *r.base;
     // The refinement appends vertices: the base vertices come first, unchanged.
-    const auto& rest = face_rig(ri).rest_mesh().positions;
-    if (rest.size() < base->positions.size() ||
-        !std::equal(base->positions.begin(), base->positions.end(), rest.begin()))
+    const auto& rest = r.rig->rest_mesh().positions;
+    if (rest.size() < base.positions.size() ||
+        !std::equal(base.positions.begin(), base.positions.end(), rest.begin()))
       fail("{}: {}: the face rig's mesh does not start with the {} base vertices", m_source, p,
-           base->positions.size());
+           base.positions.size());
+    const bool remapped = r.base != asset;
     const std::array<std::vector<skin::DirectionKey>, 2> keys{
-        fine_keys(*base, f.field0, src, p + ".field0"),
-        fine_keys(*base, f.field1, src, p + ".field1")};
+        fine_keys(base, *asset, remapped, f.field0, src, p + ".field0"),
+        fine_keys(base, *asset, remapped, f.field1, src, p + ".field1")};
     const Context gctx(m_ctx->threads(), f.seed, m_ctx->logger_ptr());
     try {
-      const skin::FineWrinkles w = skin::generate_fine_wrinkles(gctx, *base, keys, f.params);
-      r.fine = std::make_unique<skin::FineWrinkleAnimator>(*base, w);
+      const skin::FineWrinkles w = skin::generate_fine_wrinkles(gctx, base, keys, f.params);
+      r.fine = std::make_unique<skin::FineWrinkleAnimator>(base, w);
       r.fine_depth_m = w.depth_m;
       m_ctx->log().info("{}: fine wrinkles {}x{} texels, {} + {} furrows", p, w.texels.size,
                         w.texels.size, w.fields[0].furrows.size(), w.fields[1].furrows.size());

@@ -25,6 +25,10 @@ class SkinRuntime {
     std::vector<anim::ScalarTrack> muscle_tracks;  // one per muscle (empty: no track)
     anim::ScalarTrack jaw_track;
     std::optional<skin::MusclePose> pose_override;  // Session::set_skin_pose
+    // The rig's base mesh: the mesh asset, or the asset with a texture space of its own
+    // (skin[].mapping, Bando 2002 §2.4), and the large wrinkles in that texture space.
+    std::shared_ptr<const geom::TriMesh> base;
+    std::vector<skin::LargeWrinkle> wrinkles;
     std::unique_ptr<skin::FaceRig> rig;
     skin::FaceState state;
     int last_frame = -1;  // frame of `last` (-2: a still face, valid for every frame)

@@ -50,6 +50,30 @@ void validate_skin_section(const std::vector<SkinSpec>& skin,
           src, p + ".interp",
           "unknown value \"" + s.interp + "\"; expected one of \"step\", \"linear\", \"smooth\"");
     }
+    try {
+      s.mapping.validate();
+    } catch (const Error& e) {
+      json_fail(src, p + ".mapping", e.what());
+    }
+    for (std::size_t k = 0; k < s.add_surface_wrinkles.size(); ++k) {
+      try {
+        s.add_surface_wrinkles[k].validate();
+      } catch (const Error& e) {
+        json_fail(src, index_path(p + ".add_surface_wrinkles", k), e.what());
+      }
+    }
+    const bool own_uvs = s.mapping.method == geom::MappingMethod::Uv ||
+                         s.mapping.method == geom::MappingMethod::Auto;
+    if (!own_uvs && s.albedo == SkinAlbedo::Texture)
+      json_fail(src, p + ".albedo",
+                fmt::format("\"texture\" needs the mesh's own texture coordinates, and "
+                            "mapping.method is \"{}\": use \"skin_color\" or mapping \"uv\"",
+                            geom::to_string(s.mapping.method)));
+    if (!own_uvs && !s.tissue.thickness_map.empty())
+      json_fail(src, p + ".tissue.thickness_map",
+                fmt::format("a thickness map is painted in the mesh's own texture space, and "
+                            "mapping.method is \"{}\": drop the map or use mapping \"uv\"",
+                            geom::to_string(s.mapping.method)));
     std::set<std::string> over;
     for (std::size_t k = 0; k < s.wrinkle_overrides.size(); ++k)
       if (!over.insert(s.wrinkle_overrides[k].name).second)
@@ -73,13 +97,18 @@ void validate_skin_section(const std::vector<SkinSpec>& skin,
         for (std::size_t k = 0; k < keys.size(); ++k) {
           const auto& key = keys[k];
           const std::string at = index_path(kp, k);
-          if (key.vertex.has_value() == key.uv.has_value())
+          if (int(key.vertex.has_value()) + int(key.uv.has_value()) + int(key.point.has_value()) !=
+              1)
             json_fail(src, at,
-                      "give exactly one of \"vertex\" (uv vertex index) or \"uv\" (texture "
-                      "position)");
-          const double m = key.direction.norm();
+                      "give exactly one of \"vertex\" (uv vertex index), \"uv\" (texture "
+                      "position) or \"point\" (a point on the skin)");
+          if (key.direction.has_value() == key.tangent.has_value())
+            json_fail(src, at,
+                      "give exactly one of \"direction\" (texture space) or \"tangent\" (on the "
+                      "skin)");
+          const double m = key.direction ? key.direction->norm() : key.tangent->norm();
           if (!(m <= 1.0 + 1e-9))
-            json_fail(src, at + ".direction",
+            json_fail(src, at + (key.direction ? ".direction" : ".tangent"),
                       fmt::format("direction magnitude {} is out of range: expected [0, 1]", m));
         }
       }

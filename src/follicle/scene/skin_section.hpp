@@ -14,12 +14,14 @@
 
 #include "follicle/core/params.hpp"
 #include "follicle/core/types.hpp"
+#include "follicle/geom/texture_mapping_bando2002.hpp"
 #include "follicle/scene/json_params.hpp"
 #include "follicle/skin/adaptive_refine_volino1999.hpp"
 #include "follicle/skin/fine_wrinkles_bando2002.hpp"
 #include "follicle/skin/large_wrinkles_bando2002.hpp"
 #include "follicle/skin/skin_color_bando2002.hpp"
 #include "follicle/skin/tissue_bando2002.hpp"
+#include "follicle/skin/wrinkle_transfer.hpp"
 
 namespace follicle::scene {
 
@@ -98,23 +100,38 @@ struct SkinKey {
 };
 
 /// One user-given direction of a fine-wrinkle field (skin::DirectionKey, Bando 2002 §2.6.1): at a
-/// uv vertex of the mesh asset, given by its index or as the uv vertex nearest a texture position.
+/// uv vertex of the mesh asset, given by its index, as the uv vertex nearest a texture position,
+/// or as the vertex nearest a point on the skin; the direction in texture space or as a tangent
+/// on the skin. Keys in the mesh's own texture space are carried to a new layout
+/// (skin[].mapping) through the surface; a mesh without UVs takes only point and tangent.
 struct FineDirectionKeySpec {
-  static constexpr const char* kRequired[] = {"direction"};
   std::optional<int> vertex;
   std::optional<Vec2> uv;
-  Vec2 direction = Vec2::Zero();
+  std::optional<Vec3> point;
+  std::optional<Vec2> direction;
+  std::optional<Vec3> tangent;
 
   template <class V>
   void visit(V&& v) {
     v("vertex", vertex,
-      ParamInfo{"uv vertex index of the mesh asset (give vertex or uv)", "", 0.0, 1e9});
+      ParamInfo{"uv vertex index of the mesh asset's own layout (give one of vertex, uv, point)",
+                "", 0.0, 1e9});
     v("uv", uv,
-      ParamInfo{"texture position; the key goes to the nearest uv vertex (give vertex or uv)", "",
-                -10.0, 10.0});
+      ParamInfo{"texture position in the mesh asset's own layout; the key goes to the nearest uv "
+                "vertex (give one of vertex, uv, point)",
+                "", -10.0, 10.0});
+    v("point", point,
+      ParamInfo{"point on the skin (metres, the mesh's frame); the key goes to the nearest vertex "
+                "(give one of vertex, uv, point)",
+                "m", -100.0, 100.0});
     v("direction", direction,
-      ParamInfo{"furrow direction in texture space (u, v); its magnitude m in [0, 1] sets depth, "
-                "width and length of the furrows (2.5)",
+      ParamInfo{"furrow direction in texture space (u, v) of the mesh asset's own layout; its "
+                "magnitude m in [0, 1] sets depth, width and length of the furrows (2.5) (give "
+                "direction or tangent)",
+                "", -1.0, 1.0});
+    v("tangent", tangent,
+      ParamInfo{"furrow direction on the skin (mesh frame; projected onto the surface), magnitude "
+                "m in [0, 1] as for direction (give direction or tangent)",
                 "", -1.0, 1.0});
   }
 };
@@ -156,6 +173,8 @@ struct SkinSpec {
   std::optional<double> wrinkle_r;
   std::vector<WrinkleOverride> wrinkle_overrides;
   std::vector<skin::LargeWrinkle> add_wrinkles;
+  std::vector<skin::SurfaceWrinkle> add_surface_wrinkles;
+  geom::TextureMappingParams mapping;
   skin::TissueParams tissue;
   skin::RefineParams refine;
   SkinAlbedo albedo = SkinAlbedo::SkinColor;
@@ -187,7 +206,15 @@ struct SkinSpec {
                 "", 0.0, 1.0});
     v("wrinkle_overrides", wrinkle_overrides,
       ParamInfo{"per-wrinkle edits by name (applied after wrinkle_r)"});
-    v("add_wrinkles", add_wrinkles, ParamInfo{"extra wrinkles (Bezier furrows in texture space)"});
+    v("add_wrinkles", add_wrinkles,
+      ParamInfo{"extra wrinkles (Bezier furrows in the texture space of the mesh asset's own "
+                "layout)"});
+    v("add_surface_wrinkles", add_surface_wrinkles,
+      ParamInfo{"extra wrinkles given by points on the skin (metres, the mesh's frame)"});
+    v("mapping", mapping,
+      ParamInfo{"texture space of the rig (Bando 2002 §2.4): the mesh's own UVs, or a planar or "
+                "cylindrical projection with harmonic distortion minimization (auto: the mesh's "
+                "UVs when it has them)"});
     v("tissue", tissue,
       ParamInfo{"subcutaneous tissue (thickness_map relative to the scene file)"});
     v("refine", refine, ParamInfo{"adaptive refinement around the wrinkles"});

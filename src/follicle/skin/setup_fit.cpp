@@ -4,26 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "follicle/core/error.hpp"
 #include "follicle/geom/curves.hpp"
 #include "follicle/geom/spatial_embree.hpp"
+#include "follicle/geom/uv_locator.hpp"
 
 namespace follicle::skin {
-
-namespace {
-
-// Is q inside (or on) the UV triangle (a, b, c), either winding?
-bool in_triangle(const Vec2& q, const Vec2& a, const Vec2& b, const Vec2& c) {
-  auto cross = [](const Vec2& o, const Vec2& u, const Vec2& v) {
-    return (u.x() - o.x()) * (v.y() - o.y()) - (u.y() - o.y()) * (v.x() - o.x());
-  };
-  const double d0 = cross(a, b, q), d1 = cross(b, c, q), d2 = cross(c, a, q);
-  const bool neg = d0 < 0 || d1 < 0 || d2<0, pos = d0> 0 || d1 > 0 || d2 > 0;
-  return !(neg && pos);
-}
-
-}  // namespace
 
 std::vector<SetupFitReport::Muscle> SetupFitReport::off_surface(double tolerance) const {
   std::vector<Muscle> out;
@@ -49,32 +37,15 @@ SetupFitReport measure_setup_fit(const geom::TriMesh& mesh, const MuscleSet& mus
     r.muscles.push_back({m.name, query.closest_point(m.insertion).distance});
   for (const auto& m : muscles.sphincter)
     r.muscles.push_back({m.name, query.closest_point(m.center).distance});
-  // UV triangles with their boxes; a curve has 33 samples, a setup ~10 curves: a linear scan
-  // with a box test is fast enough (~20k triangles, well under a millisecond per sample).
-  struct UvTri {
-    Vec2 a, b, c, lo, hi;
-  };
-  std::vector<UvTri> tris;
-  if (mesh.has_uvs()) {
-    tris.reserve(mesh.uv_faces.size());
-    for (const auto& f : mesh.uv_faces) {
-      const Vec2 a = mesh.uvs[std::size_t(f[0])], b = mesh.uvs[std::size_t(f[1])],
-                 c = mesh.uvs[std::size_t(f[2])];
-      tris.push_back({a, b, c, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)});
-    }
-  }
+  std::unique_ptr<geom::UvLocator> locator;
+  if (mesh.has_uvs()) locator = std::make_unique<geom::UvLocator>(mesh);
   constexpr int kSamples = 33;
   for (const auto& w : wrinkles) {
     geom::Bezier2 curve;
     for (int k = 0; k < 4; ++k) curve.p[std::size_t(k)] = w.control[std::size_t(k)];
     int outside = 0;
-    for (const Vec2& q : curve.sample(kSamples)) {
-      const bool on = std::any_of(tris.begin(), tris.end(), [&](const UvTri& t) {
-        return q.x() >= t.lo.x() && q.x() <= t.hi.x() && q.y() >= t.lo.y() && q.y() <= t.hi.y() &&
-               in_triangle(q, t.a, t.b, t.c);
-      });
-      outside += !on;
-    }
+    for (const Vec2& q : curve.sample(kSamples))
+      outside += !(locator && locator->locate(q, 1e-9).face >= 0);
     r.wrinkles.push_back({w.name, double(outside) / kSamples});
   }
   return r;

@@ -174,6 +174,7 @@ FaceSetup face_setup_from_json_text(const std::string& text, const std::string& 
   try {
     s.muscles.validate();
     for (const auto& w : s.wrinkles) w.validate();
+    for (const auto& w : s.surface_wrinkles) w.validate();
   } catch (const Error& e) {
     throw Error(file, e.what());
   }

@@ -10,6 +10,7 @@
 
 #include "follicle/skin/large_wrinkles_bando2002.hpp"
 #include "follicle/skin/muscles_waters1987.hpp"
+#include "follicle/skin/wrinkle_transfer.hpp"
 
 namespace follicle::skin {
 
@@ -18,11 +19,19 @@ struct FaceSetup {
   int follicle_face = 1;  // format version
   MuscleSet muscles;
   std::vector<LargeWrinkle> wrinkles;
+  std::vector<SurfaceWrinkle> surface_wrinkles;
   template <class V>
   void visit(V&& v) {
     v("follicle_face", follicle_face, ParamInfo{"format version", "", 1, 1});
     v("muscles", muscles, ParamInfo{"muscle set", ""});
-    v("wrinkles", wrinkles, ParamInfo{"large-scale wrinkles", ""});
+    v("wrinkles", wrinkles,
+      ParamInfo{"large-scale wrinkles: Bezier curves in the texture space of the mesh the setup "
+                "was made for",
+                ""});
+    v("surface_wrinkles", surface_wrinkles,
+      ParamInfo{"large-scale wrinkles given by points on the skin (metres, the mesh's frame): "
+                "placed on whatever texture layout the mesh has or is given",
+                ""});
   }
   static constexpr const char* kRequired[] = {"follicle_face", "muscles"};
 };
