@@ -34,16 +34,18 @@ std::vector<LargeWrinkle> place_surface_wrinkles(const geom::TriMesh& mesh,
     for (std::size_t i = 0; i < w.points.size(); ++i) {
       const auto cp = query.closest_point(w.points[i]);
       if (cp.face < 0 || !(cp.distance <= max_distance))
-        fail("{}: surface wrinkle '{}': point {} lies {:.1f} mm from the skin (at most {:.0f} mm): "
-             "the points are metres in the mesh's frame; check the units and that they were made "
-             "for this head",
-             where, w.name, i, 1e3 * cp.distance, 1e3 * max_distance);
+        fail(
+            "{}: surface wrinkle '{}': point {} lies {:.1f} mm from the skin (at most {:.0f} mm): "
+            "the points are metres in the mesh's frame; check the units and that they were made "
+            "for this head",
+            where, w.name, i, 1e3 * cp.distance, 1e3 * max_distance);
       const auto f = std::size_t(cp.face);
       if (first_island < 0) first_island = island[f];
       if (island[f] != first_island)
-        fail("{}: surface wrinkle '{}' crosses a seam of the texture layout (point {} lies on "
-             "another UV island than point 0); split it into two wrinkles or change the mapping",
-             where, w.name, i);
+        fail(
+            "{}: surface wrinkle '{}' crosses a seam of the texture layout (point {} lies on "
+            "another UV island than point 0); split it into two wrinkles or change the mapping",
+            where, w.name, i);
       const Vec3i& t = mesh.uv_faces[f];
       uv.push_back(cp.bary[0] * mesh.uvs[std::size_t(t[0])] +
                    cp.bary[1] * mesh.uvs[std::size_t(t[1])] +

@@ -1,12 +1,13 @@
 // UvLocator (point location in texture space), uv_jacobian, uv_islands and fit_cubic_bezier:
 // analytic cases on a flat grid whose UVs are an affine image of its positions.
+#include "follicle/geom/uv_locator.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "follicle/core/error.hpp"
 #include "follicle/geom/curves.hpp"
-#include "follicle/geom/uv_locator.hpp"
 
 using namespace follicle;
 using namespace follicle::geom;

@@ -179,11 +179,11 @@ TEST(WrinkleTransfer, BadPointsSeamsAndMissingUvsFailWithTheWrinklesName) {
               AllOf(HasSubstr("'nowhere'"), HasSubstr("outside the mesh's texture layout")));
   // Two quads side by side with a UV island each: a wrinkle from one to the other crosses a seam.
   geom::TriMesh two;
-  two.positions = {Vec3(0, 0, 0), Vec3(0.01, 0, 0), Vec3(0.02, 0, 0),
+  two.positions = {Vec3(0, 0, 0),    Vec3(0.01, 0, 0),    Vec3(0.02, 0, 0),
                    Vec3(0, 0.01, 0), Vec3(0.01, 0.01, 0), Vec3(0.02, 0.01, 0)};
   two.faces = {Vec3i(0, 1, 4), Vec3i(0, 4, 3), Vec3i(1, 2, 5), Vec3i(1, 5, 4)};
-  two.uvs = {Vec2(0, 0), Vec2(0.4, 0), Vec2(0.4, 0.4), Vec2(0, 0.4),
-             Vec2(0.6, 0), Vec2(1, 0), Vec2(1, 0.4), Vec2(0.6, 0.4)};
+  two.uvs = {Vec2(0, 0),   Vec2(0.4, 0), Vec2(0.4, 0.4), Vec2(0, 0.4),
+             Vec2(0.6, 0), Vec2(1, 0),   Vec2(1, 0.4),   Vec2(0.6, 0.4)};
   two.uv_faces = {Vec3i(0, 1, 2), Vec3i(0, 2, 3), Vec3i(4, 5, 6), Vec3i(4, 6, 7)};
   SurfaceWrinkle cross;
   cross.name = "across";
