@@ -10,6 +10,7 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/log.hpp"
+#include "follicle/geom/mesh_io.hpp"
 #include "follicle/geom/spatial_embree.hpp"
 #include "follicle/geom/uv_locator.hpp"
 #include "follicle/image/image_io.hpp"
@@ -36,6 +37,13 @@ skin::MusclePose expression_pose(const skin::MuscleSet& set, const std::string& 
   const skin::Expression* expr = nullptr;
   for (const auto& e : set.expressions)
     if (e.name == expression) expr = &e;
+  if (!expr && expression == "neutral") {
+    // The default expression on a setup without one of that name (or without a setup file: a
+    // blendshape rig): neutral is every muscle relaxed.
+    skin::MusclePose relaxed;
+    relaxed.contractions.assign(set.num_muscles(), 0.0);
+    return relaxed;
+  }
   if (!expr) {
     const auto names = expression_names(set);
     const std::string hint = suggest(expression, names);
@@ -70,6 +78,16 @@ skin::MusclePose resolve_pose(const skin::MuscleSet& set, const std::string& exp
   }
   if (jaw) pose.jaw_angle = *jaw;
   return pose;
+}
+
+// Blendshape weights in target order (skin[].blendshapes; targets not named weigh 0). The names
+// are checked against the targets by validate_skin_section.
+std::vector<double> shape_weights(const std::vector<BlendshapeSpec>& targets,
+                                  const std::map<std::string, double>& weights) {
+  std::vector<double> w(targets.size(), 0.0);
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    if (auto it = weights.find(targets[i].name); it != weights.end()) w[i] = it->second;
+  return w;
 }
 
 // Direction keys of one fine-wrinkle field on the uv vertices of the rig's base mesh `base`.
@@ -208,9 +226,17 @@ void Session::validate_skin_files() const {
   for (std::size_t i = 0; i < m_scene.skin.size(); ++i) {
     const auto& s = m_scene.skin[i];
     const std::string p = index_path("skin", i);
-    const auto file = resolve(s.muscles);
-    if (!std::filesystem::is_regular_file(file))
-      json_fail(src, p + ".muscles", "face-setup file not found: " + file.string());
+    if (!s.muscles.empty()) {
+      const auto file = resolve(s.muscles);
+      if (!std::filesystem::is_regular_file(file))
+        json_fail(src, p + ".muscles", "face-setup file not found: " + file.string());
+    }
+    for (std::size_t k = 0; k < s.blendshapes.size(); ++k) {
+      const auto file = resolve(s.blendshapes[k].path);
+      if (!std::filesystem::is_regular_file(file))
+        json_fail(src, index_path(p + ".blendshapes", k) + ".path",
+                  "blendshape target not found: " + file.string());
+    }
     if (!s.tissue.thickness_map.empty()) {
       const auto tex = resolve(s.tissue.thickness_map);
       if (!std::filesystem::is_regular_file(tex))
@@ -226,8 +252,12 @@ void Session::resolve_skin(std::size_t ri) {
   const SkinSpec& s = m_scene.skin[ri];
   const JsonSource src{m_source};
   const std::string p = index_path("skin", ri);
-  const std::string file = resolve(s.muscles).string();
-  skin::FaceSetup setup = skin::load_face_setup(file);  // errors name the setup file and path
+  // A rig without a face-setup file (blendshapes only) has no muscles, expressions or wrinkles
+  // but those the scene adds.
+  const std::string file = s.muscles.empty() ? "(no face-setup file)" : resolve(s.muscles).string();
+  skin::FaceSetup setup;
+  if (!s.muscles.empty())
+    setup = skin::load_face_setup(file);  // errors name the setup file and path
   // Wrinkle edits: r for every wrinkle, then per-wrinkle overrides, then extra wrinkles.
   if (s.wrinkle_r) {
     for (auto& w : setup.wrinkles) w.r = *s.wrinkle_r;
@@ -280,9 +310,11 @@ void Session::resolve_skin(std::size_t ri) {
   // Poses: the still expression and the track keys (checked against the muscle set).
   r.static_pose = resolve_pose(setup.muscles, s.expression, s.weight, s.contractions, s.jaw_angle,
                                src, p, file);
+  r.static_pose.shape_weights = shape_weights(s.blendshapes, s.shapes);
   if (!s.track.empty()) {
     const std::size_t nm = setup.muscles.num_muscles();
-    std::vector<std::vector<anim::Key<double>>> keys(nm);
+    const std::size_t ns = s.blendshapes.size();
+    std::vector<std::vector<anim::Key<double>>> keys(nm), shape_keys(ns);
     std::vector<anim::Key<double>> jaw;
     for (std::size_t k = 0; k < s.track.size(); ++k) {
       const auto& key = s.track[k];
@@ -290,11 +322,16 @@ void Session::resolve_skin(std::size_t ri) {
                                      key.jaw_angle, src, index_path(p + ".track", k), file);
       for (std::size_t m = 0; m < nm; ++m) keys[m].push_back({key.t, pose.contractions[m]});
       jaw.push_back({key.t, pose.jaw_angle});
+      const auto w = shape_weights(s.blendshapes, key.shapes);
+      for (std::size_t b = 0; b < ns; ++b) shape_keys[b].push_back({key.t, w[b]});
     }
     const auto interp = anim::parse_interp(s.interp);
     for (std::size_t m = 0; m < nm; ++m)
       r.muscle_tracks.emplace_back(std::move(keys[m]), interp, p + ".track");
+    for (std::size_t b = 0; b < ns; ++b)
+      r.shape_tracks.emplace_back(std::move(shape_keys[b]), interp, p + ".track");
     r.jaw_track = anim::ScalarTrack(std::move(jaw), interp, p + ".track");
+    r.tracked = true;
   }
   r.setup = std::move(setup);
   r.resolved = true;
@@ -362,9 +399,32 @@ const skin::FaceRig& Session::face_rig(std::size_t ri) {
   if (!s.tissue.thickness_map.empty()) {
     thickness = image::read_gray_map(resolve(s.tissue.thickness_map));
   }
+  // Blendshape targets, read in the mesh asset's units and checked against its topology.
+  skin::Blendshapes shapes;
+  if (!s.blendshapes.empty()) {
+    const auto& asset_spec = m_scene.assets.meshes[mesh_index(s.mesh)];
+    std::vector<std::string> names;
+    std::vector<geom::TriMesh> targets;
+    for (std::size_t k = 0; k < s.blendshapes.size(); ++k) {
+      const auto& b = s.blendshapes[k];
+      const auto file = resolve(b.path);
+      const std::string bp = index_path(index_path("skin", ri) + ".blendshapes", k) + ".path";
+      try {
+        targets.push_back(geom::load_mesh(file, asset_spec.units));
+      } catch (const Error& e) {
+        json_fail(JsonSource{m_source}, bp, e.what());
+      }
+      names.push_back(b.name);
+    }
+    shapes = skin::Blendshapes::from_meshes(*asset, names, targets, where);
+    for (std::size_t k = 0; k < shapes.size(); ++k)
+      m_ctx->log().info("{}: blendshape \"{}\" moves {} vertices, up to {:.2f} mm", where,
+                        shapes.names()[k], shapes.moved(k), 1e3 * shapes.max_offset(k));
+  }
   try {
     r.rig = std::make_unique<skin::FaceRig>(base, r.setup.muscles, r.wrinkles, fp,
                                             thickness ? &*thickness : nullptr);
+    r.rig->set_blendshapes(shapes);
   } catch (const Error& e) {
     fail("{}: {}", where, e.what());
   }
@@ -386,11 +446,12 @@ skin::MusclePose Session::skin_pose(std::size_t ri, int frame) {
   resolve_skin(ri);
   const auto& r = skin_runtime().rigs[ri];
   if (r.pose_override) return *r.pose_override;
-  if (r.muscle_tracks.empty()) return r.static_pose;
+  if (!r.tracked) return r.static_pose;
   const double t = frame_time(frame);
   skin::MusclePose pose;
   pose.contractions.reserve(r.muscle_tracks.size());
   for (const auto& tr : r.muscle_tracks) pose.contractions.push_back(tr.value(t));
+  for (const auto& tr : r.shape_tracks) pose.shape_weights.push_back(tr.value(t));
   pose.jaw_angle = r.jaw_track.value(t);
   return pose;
 }
@@ -398,7 +459,7 @@ skin::MusclePose Session::skin_pose(std::size_t ri, int frame) {
 std::shared_ptr<const geom::TriMesh> Session::skin_mesh(std::size_t ri, int frame) {
   const skin::FaceRig& rig = face_rig(ri);
   auto& r = skin_runtime().rigs[ri];
-  const bool still = r.muscle_tracks.empty() || r.pose_override.has_value();
+  const bool still = !r.tracked || r.pose_override.has_value();
   if (r.last && (r.last_frame == frame || (still && r.last_frame == -2))) return r.last;
   rig.update(*m_ctx, skin_pose(ri, frame), r.state);
   r.last = std::make_shared<const geom::TriMesh>(rig.deformed_mesh(r.state));
@@ -421,6 +482,7 @@ void Session::set_skin_pose(std::size_t ri, const std::string& expression, doubl
   const std::string path = index_path("skin", ri);
   r.pose_override = resolve_pose(r.setup.muscles, expression, weight, contractions, jaw_angle, src,
                                  path, m_scene.skin[ri].muscles);
+  r.pose_override->shape_weights = r.static_pose.shape_weights;  // the scene's blendshape weights
   forget_frames_of_rig(ri);
 }
 

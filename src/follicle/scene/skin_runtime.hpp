@@ -22,7 +22,9 @@ class SkinRuntime {
     bool resolved = false;
     skin::FaceSetup setup;         // the face-setup file with the scene's wrinkle edits applied
     skin::MusclePose static_pose;  // expression * weight with the explicit contractions
-    std::vector<anim::ScalarTrack> muscle_tracks;  // one per muscle (empty: no track)
+    bool tracked = false;                           // skin[].track given
+    std::vector<anim::ScalarTrack> muscle_tracks;  // one per muscle
+    std::vector<anim::ScalarTrack> shape_tracks;   // one per blendshape target
     anim::ScalarTrack jaw_track;
     std::optional<skin::MusclePose> pose_override;  // Session::set_skin_pose
     // The rig's base mesh: the mesh asset, or the asset with a texture space of its own

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <set>
 
 #include "follicle/anim/keyframe_track.hpp"
@@ -37,7 +38,36 @@ void validate_skin_section(const std::vector<SkinSpec>& skin,
     }
     if (!rigged.insert(s.mesh).second)
       json_fail(src, p + ".mesh", "mesh \"" + s.mesh + "\" already has a face rig");
-    if (s.muscles.empty()) json_fail(src, p + ".muscles", "face-setup file path is empty");
+    if (s.muscles.empty() && s.blendshapes.empty())
+      json_fail(src, p + ".muscles",
+                "a face rig needs a face-setup file (\"muscles\") or blendshape targets "
+                "(\"blendshapes\"), or both");
+    // Blendshape targets: unique names, and every weight names one.
+    std::vector<std::string> shape_names;
+    for (std::size_t k = 0; k < s.blendshapes.size(); ++k) {
+      const auto& b = s.blendshapes[k];
+      const std::string bp = index_path(p + ".blendshapes", k);
+      if (b.name.empty()) json_fail(src, bp + ".name", "target name is empty");
+      if (b.path.empty()) json_fail(src, bp + ".path", "target path is empty");
+      for (const auto& n : shape_names)
+        if (n == b.name) json_fail(src, bp + ".name", "two targets are named \"" + b.name + "\"");
+      shape_names.push_back(b.name);
+    }
+    auto check_shapes = [&](const std::map<std::string, double>& w, const std::string& at) {
+      for (const auto& [name, value] : w) {
+        (void)value;
+        if (std::find(shape_names.begin(), shape_names.end(), name) != shape_names.end()) continue;
+        const std::string hint = suggest(name, shape_names);
+        json_fail(src, at + "." + name,
+                  "no blendshape target named \"" + name + "\"" +
+                      (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
+                      (shape_names.empty() ? "; skin[].blendshapes is empty"
+                                           : "; the targets are " + detail::quoted_list(shape_names)));
+      }
+    };
+    check_shapes(s.shapes, p + ".shapes");
+    for (std::size_t k = 0; k < s.track.size(); ++k)
+      check_shapes(s.track[k].shapes, index_path(p + ".track", k) + ".shapes");
     try {
       s.color.resolve();
     } catch (const Error& e) {

@@ -85,6 +85,7 @@ struct SkinKey {
   double weight = 1.0;
   std::map<std::string, double> contractions;
   std::optional<double> jaw_angle;
+  std::map<std::string, double> shapes;
 
   template <class V>
   void visit(V&& v) {
@@ -96,6 +97,24 @@ struct SkinKey {
       ParamInfo{"per-muscle contractions by name, replacing the expression's", "", -10.0, 10.0});
     v("jaw_angle", jaw_angle,
       ParamInfo{"jaw opening, replacing the expression's", "rad", -1.5, 1.5});
+    v("shapes", shapes,
+      ParamInfo{"blendshape weights by target name (skin[].blendshapes; unnamed targets 0)", "",
+                -2.0, 2.0});
+  }
+};
+
+/// One blendshape target of a skin rig: the rig's mesh with its vertices moved (same vertex count,
+/// order and faces), read in the mesh asset's units.
+struct BlendshapeSpec {
+  static constexpr const char* kRequired[] = {"name", "path"};
+  std::string name;
+  std::string path;
+  template <class V>
+  void visit(V&& v) {
+    v("name", name, ParamInfo{"target name (skin[].shapes, track[].shapes)"});
+    v("path", path,
+      ParamInfo{"mesh file of the target (OBJ, PLY, glTF; same topology as the rig's mesh, in "
+                "its units), relative to the scene file"});
   }
 };
 
@@ -162,9 +181,11 @@ struct FineWrinkleSpec {
 
 /// A face rig on one mesh asset.
 struct SkinSpec {
-  static constexpr const char* kRequired[] = {"mesh", "muscles"};
+  static constexpr const char* kRequired[] = {"mesh"};
   std::string mesh;
   std::string muscles;
+  std::vector<BlendshapeSpec> blendshapes;
+  std::map<std::string, double> shapes;
   std::string expression = "neutral";
   double weight = 1.0;
   std::map<std::string, double> contractions;
@@ -189,7 +210,15 @@ struct SkinSpec {
     v("mesh", mesh, ParamInfo{"name of the mesh asset (assets.meshes[].name) the rig deforms"});
     v("muscles", muscles,
       ParamInfo{"face-setup file (muscles, expressions, wrinkles; e.g. "
-                "data/muscles/lee_perry_smith.json), relative to the scene file"});
+                "data/muscles/lee_perry_smith.json), relative to the scene file (\"\": none; "
+                "then the rig needs blendshapes)"});
+    v("blendshapes", blendshapes,
+      ParamInfo{"blendshape targets: the mesh with its vertices moved, blended in by `shapes` on "
+                "top of the muscles; wrinkles follow the shrinkage of the whole deformation"});
+    v("shapes", shapes,
+      ParamInfo{"blendshape weights by target name when there is no track (0 neutral, 1 the "
+                "target)",
+                "", -2.0, 2.0});
     v("expression", expression,
       ParamInfo{"expression of the face-setup file shown when there is no track (\"\": none, "
                 "only the contractions)"});

@@ -61,12 +61,20 @@ MusclePose FaceRig::expression_pose(const std::string& name, double weight) cons
   return pose_from_expression(m_muscles, m_muscles.expression(name), weight);
 }
 
+void FaceRig::set_blendshapes(const Blendshapes& on_base) {
+  m_shapes = on_base.empty() ? Blendshapes{} : on_base.refined(m_refined);
+}
+
 void FaceRig::update(const Context& ctx, const MusclePose& pose, FaceState& s) const {
   const auto& rest = m_refined.mesh;
   const auto& tex = m_wrinkles->texture_mesh();
   const std::size_t nv = rest.positions.size();
-  // 1. Waters muscles and jaw.
+  if (!pose.shape_weights.empty() && pose.shape_weights.size() != m_shapes.size())
+    fail("face rig: the pose has {} shape weights and the rig {} blendshape targets",
+         pose.shape_weights.size(), m_shapes.size());
+  // 1. Waters muscles and jaw, then the blendshape offsets (a sum: both deform the rest mesh).
   m_field->apply(ctx, pose, rest.positions, s.muscle_pos);
+  m_shapes.accumulate(ctx, pose.shape_weights, s.muscle_pos);
   // 2. Subcutaneous tissue: h0/e - h0 along the normals of the muscle-deformed surface.
   compute_vertex_normals(ctx, rest, tex, s.muscle_pos, s.face_n, s.face_area, s.normals);
   s.animated.resize(nv);

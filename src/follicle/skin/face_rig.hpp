@@ -1,6 +1,6 @@
 #pragma once
 // FaceRig: the whole per-frame skin update of Bando 2002 §2.5 on a (refined) face mesh:
-//   Waters muscles + jaw -> subcutaneous tissue (h0/e - h0 along normals) -> large-scale
+//   Waters muscles + jaw (+ blendshape targets) -> subcutaneous tissue (h0/e - h0 along normals) -> large-scale
 //   wrinkles M(s) S(l) along normals, with s measured on the animated surface.
 // Construction precomputes everything (refinement, muscle influence lists, wrinkle stencils);
 // update() is a handful of parallel sparse passes (deterministic for any thread count).
@@ -12,6 +12,7 @@
 #include "follicle/geom/trimesh.hpp"
 #include "follicle/image/image.hpp"
 #include "follicle/skin/adaptive_refine_volino1999.hpp"
+#include "follicle/skin/blendshapes.hpp"
 #include "follicle/skin/large_wrinkles_bando2002.hpp"
 #include "follicle/skin/muscles_waters1987.hpp"
 #include "follicle/skin/tissue_bando2002.hpp"
@@ -64,7 +65,12 @@ class FaceRig {
   MusclePose neutral_pose() const;
   MusclePose expression_pose(const std::string& name, double weight = 1.0) const;
 
-  /// Full deformation update.
+  /// Blendshape targets on the base mesh (same vertex count and order as `base`), carried to the
+  /// refined mesh; a pose's shape_weights then blend them in (in addition to the muscles).
+  void set_blendshapes(const Blendshapes& on_base);
+  const Blendshapes& blendshapes() const { return m_shapes; }
+
+  /// Full deformation update. pose.shape_weights has one weight per blendshape target or none.
   void update(const Context& ctx, const MusclePose& pose, FaceState& out) const;
   /// The deformed mesh of a state (rest topology and UVs, state positions and normals).
   geom::TriMesh deformed_mesh(const FaceState& s) const;
@@ -82,6 +88,7 @@ class FaceRig {
   std::unique_ptr<WrinkleLayer> m_wrinkles;
   std::unique_ptr<MuscleField> m_field;
   std::unique_ptr<SubcutaneousTissue> m_tissue;
+  Blendshapes m_shapes;  // on the refined mesh
 };
 
 /// Area-weighted vertex normals, parallel and deterministic (vertex -> face CSR of `tex`).

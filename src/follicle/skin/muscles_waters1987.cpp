@@ -106,6 +106,17 @@ MusclePose blend_poses(const MusclePose& a, const MusclePose& b, double t) {
   for (std::size_t i = 0; i < p.contractions.size(); ++i)
     p.contractions[i] = (1 - t) * a.contractions[i] + t * b.contractions[i];
   p.jaw_angle = (1 - t) * a.jaw_angle + t * b.jaw_angle;
+  const std::size_t ns = std::max(a.shape_weights.size(), b.shape_weights.size());
+  if ((!a.shape_weights.empty() && a.shape_weights.size() != ns) ||
+      (!b.shape_weights.empty() && b.shape_weights.size() != ns))
+    fail("blend_poses: poses have {} and {} shape weights", a.shape_weights.size(),
+         b.shape_weights.size());
+  p.shape_weights.resize(ns);
+  for (std::size_t i = 0; i < ns; ++i) {
+    const double wa = a.shape_weights.empty() ? 0.0 : a.shape_weights[i];
+    const double wb = b.shape_weights.empty() ? 0.0 : b.shape_weights[i];
+    p.shape_weights[i] = (1 - t) * wa + t * wb;
+  }
   return p;
 }
 

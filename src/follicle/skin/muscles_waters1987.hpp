@@ -137,15 +137,18 @@ struct MuscleSet {
   const Expression& expression(const std::string& name) const;
 };
 
-/// A pose: one contraction per muscle (MuscleSet order) and a jaw angle.
+/// A pose: one contraction per muscle (MuscleSet order) and a jaw angle, plus the weights of the
+/// rig's blendshape targets (skin/blendshapes.hpp, target order; empty: none).
 struct MusclePose {
   std::vector<double> contractions;
   double jaw_angle = 0;  // [rad]
+  std::vector<double> shape_weights;
 };
 
 /// Pose of an expression scaled by `weight` (0 = neutral, 1 = full).
 MusclePose pose_from_expression(const MuscleSet& set, const Expression& e, double weight = 1.0);
-/// Linear blend of two poses (for contraction tracks): (1-t) a + t b.
+/// Linear blend of two poses (for contraction tracks): (1-t) a + t b (shape weights too; a pose
+/// without them counts as all zero).
 MusclePose blend_poses(const MusclePose& a, const MusclePose& b, double t);
 
 /// Scalar influence of one linear muscle on a point (the factor multiplying k * (p - origin));

@@ -24,7 +24,7 @@ TEST(WatersMuscle, ContractionMovesTowardOriginInsideZoneOnly) {
   lm.zone = 0.5;
   set.linear.push_back(lm);
   MuscleField field(set, m.positions);
-  MusclePose pose{{0.8}, 0.0};
+  MusclePose pose{{0.8}, 0.0, {}};
   std::vector<Vec3> out;
   field.apply(ctx, pose, m.positions, out);
   int inside = 0;
@@ -45,7 +45,7 @@ TEST(WatersMuscle, ContractionMovesTowardOriginInsideZoneOnly) {
   EXPECT_GT(inside, 50);
   // Linear in the contraction.
   std::vector<Vec3> half;
-  field.apply(ctx, MusclePose{{0.4}, 0.0}, m.positions, half);
+  field.apply(ctx, MusclePose{{0.4}, 0.0, {}}, m.positions, half);
   for (std::size_t i = 0; i < out.size(); ++i)
     EXPECT_LT(((out[i] - m.positions[i]) - 2 * (half[i] - m.positions[i])).norm(), 1e-15);
 }
@@ -62,7 +62,7 @@ TEST(WatersMuscle, JawRotatesOnlyJawRegion) {
   set.jaw.blend_width = 0.01;
   MuscleField field(set, m.positions);
   std::vector<Vec3> out;
-  field.apply(ctx, MusclePose{{}, 0.2}, m.positions, out);
+  field.apply(ctx, MusclePose{{}, 0.2, {}}, m.positions, out);
   for (std::size_t i = 0; i < out.size(); ++i) {
     const double y = m.positions[i].y();
     if (y > -0.01) {
