@@ -140,8 +140,9 @@ class Session {
   /// Scripting (Python, the viewer): replaces the pose of skin[rig] at every frame until
   /// clear_skin_pose: `expression` (of the face-setup file) * `weight`, then the named
   /// `contractions` and the jaw angle [rad] when given, with the scene's blendshape weights
-  /// (skin[].shapes). Unknown names throw follicle::Error with the names the setup has. Frames computed afterwards (the skin mesh, the hair riding it) use
-  /// it; the strand cache is neither read nor written while any rig's pose is set.
+  /// (skin[].shapes). Unknown names throw follicle::Error with the names the setup has. Frames
+  /// computed afterwards (the skin mesh, the hair riding it) use it; the strand cache is neither
+  /// read nor written while any rig's pose is set.
   void set_skin_pose(std::size_t rig, const std::string& expression, double weight,
                      const std::map<std::string, double>& contractions = {},
                      std::optional<double> jaw_angle = std::nullopt);

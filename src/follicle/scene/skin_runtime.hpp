@@ -22,7 +22,7 @@ class SkinRuntime {
     bool resolved = false;
     skin::FaceSetup setup;         // the face-setup file with the scene's wrinkle edits applied
     skin::MusclePose static_pose;  // expression * weight with the explicit contractions
-    bool tracked = false;                           // skin[].track given
+    bool tracked = false;          // skin[].track given
     std::vector<anim::ScalarTrack> muscle_tracks;  // one per muscle
     std::vector<anim::ScalarTrack> shape_tracks;   // one per blendshape target
     anim::ScalarTrack jaw_track;

@@ -58,11 +58,12 @@ void validate_skin_section(const std::vector<SkinSpec>& skin,
         (void)value;
         if (std::find(shape_names.begin(), shape_names.end(), name) != shape_names.end()) continue;
         const std::string hint = suggest(name, shape_names);
-        json_fail(src, at + "." + name,
-                  "no blendshape target named \"" + name + "\"" +
-                      (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
-                      (shape_names.empty() ? "; skin[].blendshapes is empty"
-                                           : "; the targets are " + detail::quoted_list(shape_names)));
+        json_fail(
+            src, at + "." + name,
+            "no blendshape target named \"" + name + "\"" +
+                (hint.empty() ? "" : " (did you mean \"" + hint + "\"?)") +
+                (shape_names.empty() ? "; skin[].blendshapes is empty"
+                                     : "; the targets are " + detail::quoted_list(shape_names)));
       }
     };
     check_shapes(s.shapes, p + ".shapes");

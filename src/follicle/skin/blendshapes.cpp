@@ -60,8 +60,7 @@ Blendshapes Blendshapes::from_meshes(const geom::TriMesh& neutral, std::vector<s
     std::vector<Vec3> off;
     for (std::size_t i = 0; i < m.positions.size(); ++i) {
       const Vec3 d = m.positions[i] - neutral.positions[i];
-      if (!d.allFinite())
-        fail("{}: blendshape \"{}\" has a non-finite vertex {}", where, name, i);
+      if (!d.allFinite()) fail("{}: blendshape \"{}\" has a non-finite vertex {}", where, name, i);
       if (d.norm() > kMovedEps) {
         idx.push_back(std::uint32_t(i));
         off.push_back(d);

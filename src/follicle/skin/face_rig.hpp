@@ -1,7 +1,7 @@
 #pragma once
 // FaceRig: the whole per-frame skin update of Bando 2002 §2.5 on a (refined) face mesh:
-//   Waters muscles + jaw (+ blendshape targets) -> subcutaneous tissue (h0/e - h0 along normals) -> large-scale
-//   wrinkles M(s) S(l) along normals, with s measured on the animated surface.
+//   Waters muscles + jaw (+ blendshape targets) -> subcutaneous tissue (h0/e - h0 along normals) ->
+//   large-scale wrinkles M(s) S(l) along normals, with s measured on the animated surface.
 // Construction precomputes everything (refinement, muscle influence lists, wrinkle stencils);
 // update() is a handful of parallel sparse passes (deterministic for any thread count).
 #include <memory>

@@ -205,9 +205,9 @@ TEST(SkinAnyHead, FineKeysOnTheSurfaceWorkWithoutUvs) {
     (void)s2.skin_fine_relief(0, 0);
     ADD_FAILURE() << "a uv key on a mesh without UVs was accepted";
   } catch (const Error& e) {
-    EXPECT_THAT(e.what(), AllOf(HasSubstr("skin[0].fine.field0[0]"),
-                                HasSubstr("no texture coordinates"), HasSubstr("\"point\""),
-                                HasSubstr("\"tangent\"")));
+    EXPECT_THAT(e.what(),
+                AllOf(HasSubstr("skin[0].fine.field0[0]"), HasSubstr("no texture coordinates"),
+                      HasSubstr("\"point\""), HasSubstr("\"tangent\"")));
   }
 }
 

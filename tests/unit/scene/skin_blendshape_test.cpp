@@ -53,23 +53,20 @@ Json forehead_lines(const geom::TriMesh& head) {
 }
 
 Json ict_scene() {
-  static const geom::TriMesh head = geom::load_mesh(ict("generic_neutral_mesh.obj"), LengthUnit::cm);
+  static const geom::TriMesh head =
+      geom::load_mesh(ict("generic_neutral_mesh.obj"), LengthUnit::cm);
   Json j = scene_json("skin_smile");
-  j["assets"]["meshes"][0] = {{"name", "ict"},
-                              {"path", ict("generic_neutral_mesh.obj").string()},
-                              {"units", "cm"}};
+  j["assets"]["meshes"][0] = {
+      {"name", "ict"}, {"path", ict("generic_neutral_mesh.obj").string()}, {"units", "cm"}};
   Json shapes = Json::array();
   Json weights = Json::object();
   for (const char* t : kTargets) {
     shapes.push_back({{"name", t}, {"path", ict(std::string(t) + ".obj").string()}});
     weights[t] = 1.0;
   }
-  j["skin"][0] = {{"mesh", "ict"},
-                  {"blendshapes", shapes},
-                  {"shapes", weights},
-                  {"add_surface_wrinkles", forehead_lines(head)},
-                  {"albedo", "skin_color"},
-                  {"refine", {{"max_levels", 1}}}};
+  j["skin"][0] = {{"mesh", "ict"},          {"blendshapes", shapes},
+                  {"shapes", weights},      {"add_surface_wrinkles", forehead_lines(head)},
+                  {"albedo", "skin_color"}, {"refine", {{"max_levels", 1}}}};
   return j;
 }
 
@@ -159,8 +156,8 @@ TEST(SkinBlendshape, BadTargetsAndNamesFailWithTheJsonPath) {
                                   HasSubstr("26719"), HasSubstr("same mesh")));
   Json missing = ict_scene();
   missing["skin"][0]["blendshapes"][0]["path"] = "nowhere.obj";
-  EXPECT_THAT(rig_error(missing), AllOf(HasSubstr("skin[0].blendshapes[0].path"),
-                                        HasSubstr("not found")));
+  EXPECT_THAT(rig_error(missing),
+              AllOf(HasSubstr("skin[0].blendshapes[0].path"), HasSubstr("not found")));
   Json typo = ict_scene();
   typo["skin"][0]["shapes"] = {{"browInnerUp_l", 1.0}};
   EXPECT_THAT(read_error(typo), AllOf(HasSubstr("skin[0].shapes.browInnerUp_l"),
@@ -171,8 +168,8 @@ TEST(SkinBlendshape, BadTargetsAndNamesFailWithTheJsonPath) {
   EXPECT_THAT(read_error(track), HasSubstr("skin[0].track[0].shapes.smile"));
   Json dup = ict_scene();
   dup["skin"][0]["blendshapes"][1]["name"] = "browInnerUp_L";
-  EXPECT_THAT(read_error(dup), AllOf(HasSubstr("skin[0].blendshapes[1].name"),
-                                     HasSubstr("two targets")));
+  EXPECT_THAT(read_error(dup),
+              AllOf(HasSubstr("skin[0].blendshapes[1].name"), HasSubstr("two targets")));
   Json none = ict_scene();
   none["skin"][0].erase("blendshapes");
   none["skin"][0].erase("shapes");

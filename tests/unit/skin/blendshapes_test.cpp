@@ -22,7 +22,9 @@ using ::testing::HasSubstr;
 
 namespace {
 
-geom::TriMesh patch() { return make_cylinder_patch(0.08, 0.06, 0.08, 0.003); }
+geom::TriMesh patch() {
+  return make_cylinder_patch(0.08, 0.06, 0.08, 0.003);
+}
 
 std::string error_of(const std::function<void()>& f) {
   try {
@@ -63,7 +65,7 @@ TEST(Blendshapes, BlendIsLinearInTheWeightsAndSumsTargets) {
   geom::TriMesh a = n, b = n;
   for (std::size_t i = 0; i < n.positions.size(); ++i) {
     a.positions[i] += Vec3(0, 0.001 * n.positions[i].x(), 0);  // a shear
-    if (i % 3 == 0) b.positions[i] += Vec3(0.0005, 0, 0);       // a few vertices only
+    if (i % 3 == 0) b.positions[i] += Vec3(0.0005, 0, 0);      // a few vertices only
   }
   const auto bs = Blendshapes::from_meshes(n, {"a", "b"}, {a, b}, "test");
   ASSERT_EQ(bs.size(), 2u);
@@ -149,7 +151,9 @@ TEST(Blendshapes, ATargetHoldingAMuscleExpressionWrinklesLikeTheMuscles) {
   // Weight 0: the neutral face, no furrow (r = 0).
   shapes.update(ctx, MusclePose{{}, 0.0, {0.0}}, ss);
   for (double h : ss.wrinkle_height) EXPECT_EQ(h, 0.0);
-  EXPECT_THAT(error_of([&] { shapes.update(ctx, MusclePose{{}, 0.0, {1.0, 1.0}}, ss); }),
+  EXPECT_THAT(error_of([&] {
+                shapes.update(ctx, MusclePose{{}, 0.0, {1.0, 1.0}}, ss);
+              }),
               HasSubstr("2 shape weights and the rig 1 blendshape targets"));
 
   // With refinement the inserted vertices follow the target linearly (it knows the deformation
@@ -205,7 +209,9 @@ TEST(Blendshapes, TargetsOfAnotherTopologyAreRefused) {
     recut.faces[11] = Vec3i(quad[1], quad[3], quad[0]);
   }
   EXPECT_EQ(error_of([&] { Blendshapes::from_meshes(n, {"recut"}, {recut}, "w"); }), "");
-  EXPECT_THAT(error_of([&] { Blendshapes::from_meshes(n, {"a", "a"}, {n, n}, "w"); }),
+  EXPECT_THAT(error_of([&] {
+                Blendshapes::from_meshes(n, {"a", "a"}, {n, n}, "w");
+              }),
               HasSubstr("two blendshapes are named \"a\""));
   geom::TriMesh nan = n;
   nan.positions[3].x() = std::nan("");
