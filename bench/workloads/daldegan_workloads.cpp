@@ -97,7 +97,7 @@ class DynamicsInstance final : public WorkloadInstance {
     }
     typical = hair::resample_groom_fixed(typical, std::size_t(segments) + 1);
     // Head frame: origin at the fitted hull's centre, its axes (y up, z to the face).
-    const sim::Ellipsoid hull = sim::fit_head_ellipsoid(head.positions, {});
+    const sim::Ellipsoid hull = sim::fit_head_ellipsoid(head.positions);
     m_centre = hull.centre;
     m_rh = hull.rotation;
     for (auto& p : typical.strands.points)

@@ -50,11 +50,12 @@ class Daldegan1993Simulation final : public HairSimulation {
     } else {
       m_guides_rest = resample_groom_fixed(guides, std::size_t(p.guide_segments) + 1).strands;
     }
-    // §3.4 step 2: radius tables of the body, head frame (y up, z to the face).
+    // §3.4 step 2: radius tables of the body, about the head's up axis with the seam behind
+    // (the hull's axes: the head's found or declared orientation).
     std::shared_ptr<const sim::CylinderBody> body;
     if (p.collision && setup.head_mesh)
-      body = std::make_shared<const sim::CylinderBody>(
-          sim::build_cylinder_body(ctx, *setup.head_mesh, Vec3::UnitY(), Vec3::UnitZ(), p.body));
+      body = std::make_shared<const sim::CylinderBody>(sim::build_cylinder_body(
+          ctx, *setup.head_mesh, setup.hull.rotation.col(1), setup.hull.rotation.col(2), p.body));
     m_solver = std::make_unique<HingeSolver>(p.hinge, m_guides_rest, std::move(body));
     // §3.3: every strand of the full hair follows its typical strand.
     if (!m_all_guides) m_wisps = bind_wisps(ctx, m_guides_rest, m_full_rest, p.wisps);

@@ -24,7 +24,7 @@ void ForceField::validate() const {
 }
 
 Vec3 ForceField::accel(const sim::Ellipsoid& hull, const Vec3& p) const {
-  if (kind == "uniform") return vector;
+  if (kind == "uniform") return hull.rotation * vector;  // given in the head's axes
   if (kind == "attract") {
     const Vec3 t = hull.from_normalized(point) - p;
     const double n = t.norm();
@@ -146,7 +146,7 @@ void style_roots(const Context& ctx, const sim::Ellipsoid& hull, const HairPart&
         } else {
           // Combed along the hull to the tie, then a separately designed tail (Fig. 6c).
           Rng rng = Rng::stream(seed ^ 0x7A11ull, s);
-          const Vec3 tail_dir = part.tie.tail_direction.normalized();
+          const Vec3 tail_dir = (hull.rotation * part.tie.tail_direction).normalized();
           Vec3 e1 = tail_dir.cross(Vec3::UnitX());
           if (e1.norm() < 1e-6) e1 = tail_dir.cross(Vec3::UnitY());
           e1.normalize();

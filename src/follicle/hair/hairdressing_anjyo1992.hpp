@@ -51,7 +51,7 @@ struct NodeRange {
 /// `point`, normalized hull coordinates), "radial" (strength away from the hull centre).
 struct ForceField {
   std::string kind = "uniform";
-  Vec3 vector = Vec3::Zero();  // [m/s²] uniform field (world axes)
+  Vec3 vector = Vec3::Zero();  // [m/s²] uniform field (the hull's axes: x left, y up, z face)
   Vec3 point = Vec3::Zero();   // attract: target in normalized hull coordinates
   double strength = 0.0;       // [m/s²] attract / radial
   PolarRange pores;
@@ -59,7 +59,7 @@ struct ForceField {
   template <class V>
   void visit(V&& v) {
     v("kind", kind, {"uniform | attract | radial"});
-    v("vector", vector, {"uniform field", "m/s^2", -1e4, 1e4});
+    v("vector", vector, {"uniform field (head axes: x left, y up, z face)", "m/s^2", -1e4, 1e4});
     v("point", point, {"attract target (normalized hull coordinates)", "", -10.0, 10.0});
     v("strength", strength, {"attract/radial strength", "m/s^2", -1e4, 1e4});
     v("pores", pores);
@@ -100,14 +100,14 @@ struct TieParams {
   bool enabled = false;
   Vec3 point{0.0, 0.35, -1.0};          // tie position (normalized hull coordinates)
   double radius = 0.012;                // [m] radius of the tail at the tie
-  Vec3 tail_direction{0.0, 0.2, -1.0};  // initial tail direction (world)
+  Vec3 tail_direction{0.0, 0.2, -1.0};  // initial tail direction (the hull's axes)
   double surface_offset = 0.004;        // [m] combed hair lies this far outside the hull
   template <class V>
   void visit(V&& v) {
     v("enabled", enabled, {"tie this part into a tail"});
     v("point", point, {"tie point (normalized hull coordinates)", "", -10.0, 10.0});
     v("radius", radius, {"tail radius at the tie", "m", 0.0, 0.2});
-    v("tail_direction", tail_direction, {"initial tail direction", "", -1.0, 1.0});
+    v("tail_direction", tail_direction, {"initial tail direction (head axes)", "", -1.0, 1.0});
     v("surface_offset", surface_offset, {"combed hair height above the hull", "m", 0.0, 0.05});
   }
 };

@@ -1,5 +1,7 @@
 #include "follicle/render/camera.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace follicle::render {
@@ -62,6 +64,20 @@ std::optional<Vec2> project_to_pixel(const Camera& cam, int width, int height, c
   if (c.w() <= 0) return std::nullopt;
   const double x = c.x() / c.w(), y = c.y() / c.w();
   return Vec2((x * 0.5 + 0.5) * width, (0.5 - y * 0.5) * height);
+}
+
+bool box_in_view(const Camera& cam, double aspect, const Eigen::AlignedBox3d& box) {
+  if (box.isEmpty()) return false;
+  const Mat4 M = projection_matrix(cam, aspect) * view_matrix(cam);
+  std::array<int, 6> beyond{};  // corners beyond -x, +x, -y, +y, near, far
+  for (int k = 0; k < 8; ++k) {
+    const Vec4 c = M * box.corner(Eigen::AlignedBox3d::CornerType(k)).homogeneous();
+    for (int a = 0; a < 3; ++a) {
+      if (c[a] < -c.w()) ++beyond[std::size_t(2 * a)];
+      if (c[a] > c.w()) ++beyond[std::size_t(2 * a + 1)];
+    }
+  }
+  return std::none_of(beyond.begin(), beyond.end(), [](int n) { return n == 8; });
 }
 
 }  // namespace follicle::render

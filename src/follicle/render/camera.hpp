@@ -19,4 +19,9 @@ Mat4 orthographic(double left, double right, double bottom, double top, double z
 /// in a width x height image; nullopt when p is behind the camera.
 std::optional<Vec2> project_to_pixel(const Camera& cam, int width, int height, const Vec3& p);
 
+/// Whether any of the world box can be in the view: false when all eight corners lie beyond one
+/// plane of the view frustum (near and far included). Conservative: a box across a frustum edge
+/// counts as seen.
+bool box_in_view(const Camera& cam, double aspect, const Eigen::AlignedBox3d& box);
+
 }  // namespace follicle::render

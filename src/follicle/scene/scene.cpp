@@ -42,6 +42,13 @@ void Scene::validate(const JsonSource& src) const {
     const auto& m = assets.meshes[i];
     const std::string p = index_path("assets.meshes", i);
     if (m.path.empty()) json_fail(src, p + ".path", "mesh path is empty");
+    if (m.up.norm() < 1e-9) json_fail(src, p + ".up", "up direction is zero");
+    if (m.front.norm() < 1e-9) json_fail(src, p + ".front", "front direction is zero");
+    if (m.up.normalized().cross(m.front.normalized()).norm() < 0.5)
+      json_fail(src, p + ".front",
+                fmt::format("front [{}, {}, {}] is within 30 degrees of up [{}, {}, {}]; the face "
+                            "looks across the head's up direction",
+                            m.front.x(), m.front.y(), m.front.z(), m.up.x(), m.up.y(), m.up.z()));
     if (!m.name.empty() && !names.insert(m.name).second)
       json_fail(src, p + ".name", "duplicate mesh name \"" + m.name + "\"");
   }

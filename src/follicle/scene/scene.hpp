@@ -83,12 +83,22 @@ struct MeshAsset {
   Material material;
   bool cast_shadow = true;
   bool visible = true;
+  // The head's orientation in the file's own frame: hair hulls, styles and colliders are laid out
+  // in the head frame (x left = up x front, y up, z towards the face), whatever way the file faces.
+  Vec3 up{0.0, 1.0, 0.0};
+  Vec3 front{0.0, 0.0, 1.0};
 
   template <class V>
   void visit(V&& v) {
     v("name", name, ParamInfo{"identifier other sections use to refer to this mesh"});
     v("path", path, ParamInfo{"mesh file (.obj, .ply, .gltf, .glb), relative to the scene file"});
     v("units", units, ParamInfo{"length unit of the coordinates in the file"});
+    v("up", up,
+      ParamInfo{"the head's up direction in the file's frame (hair hull, styles, colliders)", "",
+                -1e3, 1e3});
+    v("front", front,
+      ParamInfo{"the direction the face looks in the file's frame (made orthogonal to up)", "",
+                -1e3, 1e3});
     v("transform", transform, ParamInfo{"placement in the scene"});
     v("material", material, ParamInfo{"surface appearance"});
     v("cast_shadow", cast_shadow, ParamInfo{"whether the mesh casts shadows"});

@@ -8,6 +8,7 @@
 #include "follicle/geom/mesh_io.hpp"
 #include "follicle/hair/shading_anjyo1992.hpp"
 #include "follicle/image/image_io.hpp"
+#include "follicle/render/camera.hpp"
 #include "follicle/scene/hair_runtime.hpp"
 
 namespace follicle::scene {
@@ -192,7 +193,34 @@ render::RenderScene Session::render_scene(int frame) {
   }
   add_hand_items(rs, frame);  // session_hand.cpp
   add_lcp_items(rs, frame);   // session_lcp.cpp
+  if (!m_view_checked) {
+    m_view_checked = true;
+    check_in_view(rs);
+  }
   return rs;
+}
+
+void Session::check_in_view(const render::RenderScene& rs) const {
+  // A mesh placed where the camera does not look (another unit, another origin, a camera from
+  // another scene) renders as an empty background; name it once, with the likely fix.
+  const double aspect = double(m_scene.render.width) / double(m_scene.render.height);
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < m_scene.assets.meshes.size(); ++i) {
+    const auto& a = m_scene.assets.meshes[i];
+    if (!a.visible) continue;
+    const render::MeshItem& item = rs.meshes[k++];
+    Eigen::AlignedBox3d box;
+    for (const auto& p : item.mesh->positions) box.extend(item.transform * p);
+    if (render::box_in_view(rs.camera, aspect, box)) continue;
+    const Vec3 c = box.center(), e = rs.camera.eye, t = rs.camera.target;
+    m_ctx->log().warn(
+        "{}: mesh \"{}\" (assets.meshes[{}]) is outside the camera's view: it is {:.3g} m across "
+        "around [{:.3g}, {:.3g}, {:.3g}] m, the camera at [{:.3g}, {:.3g}, {:.3g}] looks at "
+        "[{:.3g}, {:.3g}, {:.3g}] (fov {:.3g} deg, near {:.3g}, far {:.3g}); set camera.target to "
+        "the mesh's centre, or check the mesh's units and transform",
+        m_source, a.name, i, box.diagonal().norm(), c.x(), c.y(), c.z(), e.x(), e.y(), e.z(), t.x(),
+        t.y(), t.z(), rs.camera.fov_y * 180.0 / kPi, rs.camera.z_near, rs.camera.z_far);
+  }
 }
 
 void Session::add_daldegan_items(render::RenderScene& rs, std::size_t gi, int frame) {

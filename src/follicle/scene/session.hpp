@@ -106,8 +106,12 @@ class Session {
   /// The pivot of the rigid head motion: animation.head_motion.pivot, or the bottom of hair[0]'s
   /// hull (roughly where the neck turns the head).
   Vec3 head_motion_pivot();
-  /// The head hull of hair group `group` (its `hull`, or fitted to its mesh at rest).
+  /// The head hull of hair group `group` (its `hull`, or fitted to its mesh at rest in the
+  /// mesh's head frame).
   sim::Ellipsoid hair_hull(std::size_t group);
+  /// The head frame of assets.meshes[index] in the scene: a rotation whose columns are left
+  /// (up x front), up and front, from the asset's `up`/`front` through its transform.
+  Mat3 head_frame(std::size_t mesh_index) const;
   /// The rigid head-motion transform at `frame` (rest -> current), none for a still head.
   std::optional<Affine3> head_motion_transform(int frame);
 
@@ -177,6 +181,8 @@ class Session {
   void build_hair_group(std::size_t group);
   void check_head_size(std::size_t mesh, const geom::TriMesh& world,
                        const std::string& where) const;
+  void check_in_view(const render::RenderScene& rs) const;
+  bool m_view_checked = false;  // check_in_view runs on the first render_scene
   void ride_skin(std::size_t group, int frame, geom::StrandSet& strands);
   std::shared_ptr<HandRuntime> m_hand;  // shared_ptr: incomplete type here
   std::shared_ptr<LcpRuntime> m_lcp;

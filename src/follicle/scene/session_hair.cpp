@@ -343,7 +343,20 @@ sim::Ellipsoid Session::hair_hull(std::size_t gi) {
   const std::size_t mi = mesh_index(hs.mesh);
   geom::TriMesh world = *mesh(mi);
   world.transform(m_scene.assets.meshes[mi].transform.matrix());
-  return sim::fit_head_ellipsoid(world.positions, hs.hull_fit);
+  return sim::fit_head_ellipsoid(world.positions, head_frame(mi), hs.hull_fit);
+}
+
+Mat3 Session::head_frame(std::size_t mi) const {
+  const auto& a = m_scene.assets.meshes.at(mi);
+  const Mat3 L = a.transform.matrix().linear();
+  const Vec3 up = (L * a.up).normalized();
+  Vec3 front = L * a.front;
+  front = (front - front.dot(up) * up).normalized();  // validated: at least 30 degrees apart
+  Mat3 R;
+  R.col(0) = up.cross(front);
+  R.col(1) = up;
+  R.col(2) = front;
+  return R;
 }
 
 Vec3 Session::head_motion_pivot() {

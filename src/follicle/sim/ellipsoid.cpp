@@ -159,4 +159,18 @@ Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions, const Ellipsoid
   return e;
 }
 
+Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions, const Mat3& frame,
+                             const EllipsoidFitParams& params) {
+  if (!frame.allFinite() || (frame.transpose() * frame - Mat3::Identity()).norm() > 1e-9 ||
+      frame.determinant() < 0)
+    fail("ellipsoid fit: the head frame is not a rotation");
+  std::vector<Vec3> local(positions.size());
+  const Mat3 RT = frame.transpose();
+  for (std::size_t i = 0; i < positions.size(); ++i) local[i] = RT * positions[i];
+  Ellipsoid e = fit_head_ellipsoid(local, params);
+  e.centre = frame * e.centre;
+  e.rotation = frame;
+  return e;
+}
+
 }  // namespace follicle::sim

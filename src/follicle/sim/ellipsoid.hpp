@@ -80,5 +80,10 @@ struct EllipsoidFitParams {
 /// mesh has too few vertices or the fit degenerates.
 Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions,
                              const EllipsoidFitParams& params = {});
+/// The same fit in a head frame: `frame` is a rotation whose columns are the head's left, up and
+/// face directions in world; the cap is taken along its up axis and the hull gets that rotation,
+/// so a head facing any way gets the hull (and every style laid out on it) it would get upright.
+Ellipsoid fit_head_ellipsoid(const std::vector<Vec3>& positions, const Mat3& frame,
+                             const EllipsoidFitParams& params = {});
 
 }  // namespace follicle::sim

@@ -5,6 +5,7 @@
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
+#include "follicle/geom/uv_locator.hpp"
 
 namespace follicle::skin {
 
@@ -104,6 +105,7 @@ WrinkleLayer::WrinkleLayer(const geom::TriMesh& rest, std::vector<LargeWrinkle> 
       m_wrinkles(std::move(wrinkles)),
       m_cutoff(cutoff_widths),
       m_method(method) {
+  m_face_island = geom::uv_islands(m_rest);
   std::vector<int> all(rest.faces.size());
   for (std::size_t f = 0; f < all.size(); ++f) all[f] = int(f);
   m_global_scale = texture_scale(m_rest, m_tex, all);
@@ -153,11 +155,87 @@ double smoothstep01(double x) {
 }
 }  // namespace
 
+namespace {
+bool in_uv_triangle(const std::array<Vec2, 3>& t, const Vec2& q) {
+  auto cross = [](const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); };
+  const double d1 = cross(t[1] - t[0], q - t[0]), d2 = cross(t[2] - t[1], q - t[1]),
+               d3 = cross(t[0] - t[2], q - t[2]);
+  const double area = cross(t[1] - t[0], t[2] - t[0]);
+  if (std::abs(area) < 1e-300) return false;
+  return (d1 >= 0 && d2 >= 0 && d3 >= 0) || (d1 <= 0 && d2 <= 0 && d3 <= 0);
+}
+}  // namespace
+
+int WrinkleLayer::curve_island(const BezierDistance& bd) const {
+  // Texture space may hold several UV islands on top of each other (eyes, teeth, the back of a
+  // scanned head laid over the face). The curve belongs to the island whose UV triangles hold
+  // most of its samples; ties go to the island with more 3D area under the samples.
+  constexpr int kSamples = 33;
+  std::array<Vec2, kSamples> q;
+  for (int k = 0; k < kSamples; ++k)
+    q[std::size_t(k)] = bd.curve().eval(double(k) / (kSamples - 1));
+  const Eigen::AlignedBox2d box = bd.bounds();
+  std::vector<std::pair<int, int>> hits;     // (island, sample)
+  std::vector<std::pair<int, double>> area;  // (island, 3D area of the holding faces)
+  for (std::size_t f = 0; f < m_rest.faces.size(); ++f) {
+    const auto& t = m_tex.face_uv[f];
+    Eigen::AlignedBox2d fb(t[0]);
+    fb.extend(t[1]);
+    fb.extend(t[2]);
+    if (!fb.intersects(box)) continue;
+    bool any = false;
+    for (int k = 0; k < kSamples; ++k)
+      if (fb.contains(q[std::size_t(k)]) && in_uv_triangle(t, q[std::size_t(k)])) {
+        hits.emplace_back(m_face_island[f], k);
+        any = true;
+      }
+    if (any) area.emplace_back(m_face_island[f], m_rest.face_area(f));
+  }
+  if (hits.empty()) return -1;
+  std::sort(hits.begin(), hits.end());
+  hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+  std::sort(area.begin(), area.end());
+  int best = -1, best_count = 0;
+  double best_area = 0;
+  for (std::size_t a = 0, b = 0; a < hits.size(); a = b) {
+    const int isl = hits[a].first;
+    while (b < hits.size() && hits[b].first == isl) ++b;
+    const int count = int(b - a);
+    double ar = 0;
+    for (const auto& [i2, x] : area)
+      if (i2 == isl) ar += x;
+    if (count > best_count || (count == best_count && ar > best_area)) {
+      best = isl;
+      best_count = count;
+      best_area = ar;
+    }
+  }
+  return best;
+}
+
 void WrinkleLayer::build(std::size_t i) {
   const LargeWrinkle& w = m_wrinkles[i];
   WrinkleInfluence infl;
   const BezierDistance bd(CubicBezier2{w.control});
   const std::size_t nv = m_rest.positions.size();
+  const int island = curve_island(bd);
+  infl.island = island;
+  auto in_island = [&](std::size_t f) { return island < 0 || m_face_island[f] == island; };
+  // A vertex's texture position on the wrinkle's island (a seam vertex has one per island).
+  auto island_uv = [&](std::size_t v, Vec2& uv) {
+    if (island < 0) {
+      uv = m_tex.vertex_uv[v];
+      return true;
+    }
+    for (std::size_t k = m_tex.vf_offsets[v]; k < m_tex.vf_offsets[v + 1]; ++k) {
+      const auto f = std::size_t(m_tex.vf_faces[k]);
+      if (m_face_island[f] == island) {
+        uv = m_tex.face_uv[f][std::size_t(m_tex.vf_corner[k])];
+        return true;
+      }
+    }
+    return false;
+  };
   // Local texture scale from the faces around the curve (first with the global scale).
   double scale = m_global_scale;
   for (int pass = 0; pass < 2; ++pass) {
@@ -167,6 +245,7 @@ void WrinkleLayer::build(std::size_t i) {
     box.max().array() += radius_uv;
     std::vector<int> near;
     for (std::size_t f = 0; f < m_rest.faces.size(); ++f) {
+      if (!in_island(f)) continue;
       const auto& uv = m_tex.face_uv[f];
       const Vec2 c = (uv[0] + uv[1] + uv[2]) / 3.0;
       if (box.contains(c) && bd.project(c).distance <= radius_uv) near.push_back(int(f));
@@ -179,8 +258,8 @@ void WrinkleLayer::build(std::size_t i) {
   box.min().array() -= radius_uv;
   box.max().array() += radius_uv;
   for (std::size_t v = 0; v < nv; ++v) {
-    const Vec2 q = m_tex.vertex_uv[v];
-    if (!box.contains(q)) continue;
+    Vec2 q;
+    if (!island_uv(v, q) || !box.contains(q)) continue;
     const CurveProjection pr = bd.project(q);
     if (pr.distance > radius_uv) continue;
     double taper = 1.0;
@@ -199,6 +278,7 @@ void WrinkleLayer::build(std::size_t i) {
       const Vec2 d = sgn == 0 ? dp : Vec2(-dp);
       for (std::size_t k = m_tex.vf_offsets[v]; k < m_tex.vf_offsets[v + 1]; ++k) {
         const auto f = std::size_t(m_tex.vf_faces[k]);
+        if (!in_island(f)) continue;  // another island's UVs live in another chart
         const int c = m_tex.vf_corner[k];
         const auto& uv = m_tex.face_uv[f];
         const Vec2 e2 = uv[std::size_t((c + 1) % 3)] - uv[std::size_t(c)];

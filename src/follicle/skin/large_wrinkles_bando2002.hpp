@@ -4,6 +4,8 @@
 // Vertices near the furrow are displaced along their normals by M(s) S(l), with l the
 // perpendicular texture-space distance (converted to metres by the local texture scale) and s
 // the shrinkage (2.3) of the skin perpendicular to the furrow, measured on the animated mesh.
+// The paper's face has one texture chart; real heads lay several UV islands over each other, so
+// each curve is given to the island holding most of it and touches only that island's skin.
 #include <array>
 #include <string>
 #include <vector>
@@ -67,6 +69,7 @@ struct WrinkleInfluence {
   };
   std::vector<Entry> entries;
   double texture_scale = 0;  // metres per texture unit around this wrinkle
+  int island = -1;  // UV island the curve lies on (geom::uv_islands numbering); -1: on none
 };
 
 /// How L' in (2.3) is measured for the triangle in direction d_p.
@@ -107,6 +110,7 @@ class WrinkleLayer {
 
  private:
   void build(std::size_t i);
+  int curve_island(const BezierDistance& bd) const;
   void build_vertex_index();
   double entry_shrinkage(const WrinkleInfluence::Entry& e, const std::vector<Vec3>& p) const;
   geom::TriMesh m_rest;
@@ -121,6 +125,7 @@ class WrinkleLayer {
   double m_cutoff;
   ShrinkageMethod m_method;
   double m_global_scale = 1;
+  std::vector<int> m_face_island;  // UV island of every rest face
 };
 
 /// Metres per texture unit over a set of faces: sqrt(sum A_3d / sum A_uv).
