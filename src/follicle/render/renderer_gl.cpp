@@ -17,6 +17,9 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
 
 #include "follicle/core/parallel.hpp"
 #include "follicle/core/resources.hpp"
@@ -120,11 +123,19 @@ void extend(Eigen::AlignedBox3d& box, const Affine3& xf, const Vec3& p) {
   box.extend(xf * p);
 }
 
-/// Builds the unwelded per-corner vertex array of a mesh. Normals: the mesh's own, else
-/// area-weighted face normals. Pu, Pv (dP/du, dP/dv) are averaged per UV vertex so the tangent
-/// frame is smooth within a UV chart.
-std::vector<MeshVertex> build_mesh_vertices(const MeshItem& item, std::size_t index,
-                                            Eigen::AlignedBox3d* shadow_box) {
+/// The vertex and index arrays of a mesh: one vertex per distinct (position, UV) corner pair,
+/// so UV seams split vertices and nothing else does (every attribute is a function of that pair:
+/// the image is the one an unwelded corner array gives, with ~6x fewer vertex-shader runs).
+struct MeshArrays {
+  std::vector<MeshVertex> vertices;
+  std::vector<uint32_t> indices;
+};
+
+/// Builds the vertex arrays of a mesh. Normals: the mesh's own, else area-weighted face normals.
+/// Pu, Pv (dP/du, dP/dv) are averaged per UV vertex so the tangent frame is smooth within a UV
+/// chart.
+MeshArrays build_mesh_vertices(const MeshItem& item, std::size_t index,
+                               Eigen::AlignedBox3d* shadow_box) {
   const geom::TriMesh& m = *item.mesh;
   const std::string where = fmt::format("render: meshes[{}] '{}'", index, m.name);
   const std::size_t nv = m.positions.size();
@@ -185,14 +196,23 @@ std::vector<MeshVertex> build_mesh_vertices(const MeshItem& item, std::size_t in
         pv[i] /= cnt[i];
       }
   }
-  std::vector<MeshVertex> out(m.faces.size() * 3);
+  MeshArrays out;
+  out.indices.resize(m.faces.size() * 3);
+  out.vertices.reserve(nv + nv / 8);
+  std::unordered_map<uint64_t, uint32_t> slot;  // (position, UV) pair -> vertex
+  slot.reserve(nv + nv / 8);
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const std::size_t vi = std::size_t(m.faces[f][k]);
-      MeshVertex& v = out[f * 3 + std::size_t(k)];
       const Vec3& p = m.positions[vi];
       if (!p.allFinite()) fail_at(where, "vertex {} is not finite", vi);
       if (shadow_box) extend(*shadow_box, item.transform, p);
+      const uint64_t key =
+          uint64_t(vi) * (uint64_t(m.uvs.size()) + 1) + (uvs ? uint64_t(m.uv_faces[f][k]) + 1 : 0);
+      const auto [it, fresh] = slot.try_emplace(key, uint32_t(out.vertices.size()));
+      out.indices[f * 3 + std::size_t(k)] = it->second;
+      if (!fresh) continue;
+      MeshVertex& v = out.vertices.emplace_back();
       Vec3 n = normals[vi];
       n = n.norm() > 0 ? n.normalized() : Vec3(0, 0, 1);
       const Vec3 c = vcol ? item.vertex_colors[vi].cast<double>() : Vec3(1, 1, 1);
@@ -237,6 +257,7 @@ class GlRenderer final : public Renderer {
         glDeleteProgram(p);
       for (auto& [key, p] : m_mesh_progs) glDeleteProgram(p);
       for (auto& [k, t] : m_tex_cache) glDeleteTextures(1, &t.tex);
+      for (auto& [k, e] : m_mesh_cache) release(e);
       release_targets();
       glDeleteVertexArrays(1, &m_empty_vao);
       glDeleteBuffers(1, &m_quad_vbo);
@@ -507,24 +528,24 @@ class GlRenderer final : public Renderer {
 
     // ---- upload -------------------------------------------------------------------------------
     std::vector<MeshDraw> meshes;
+    for (auto& [key, e] : m_mesh_cache) e.used = false;
     for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
       const MeshItem& item = scene.meshes[i];
       if (!item.mesh || item.mesh->faces.empty()) continue;
-      const auto verts = build_mesh_vertices(item, i, item.cast_shadow ? sb : nullptr);
       MeshDraw d;
-      d.vao = fo.vao();
-      fo.buffer(GL_ARRAY_BUFFER, verts.size() * sizeof(MeshVertex), verts.data());
-      const std::size_t s = sizeof(MeshVertex);
-      attrib(0, 3, s, offsetof(MeshVertex, pos));
-      attrib(1, 3, s, offsetof(MeshVertex, normal));
-      attrib(2, 2, s, offsetof(MeshVertex, uv));
-      attrib(3, 3, s, offsetof(MeshVertex, color));
-      attrib(4, 3, s, offsetof(MeshVertex, pu));
-      attrib(5, 3, s, offsetof(MeshVertex, pv));
-      d.count = GLsizei(verts.size());
+      std::tie(d.vao, d.count) = mesh_buffer(fo, item, i, item.cast_shadow ? sb : nullptr);
       d.item = &item;
       d.has_uvs = item.mesh->has_uvs();
       meshes.push_back(d);
+    }
+    // Buffers of meshes not drawn this frame go (an animation makes a new mesh every frame).
+    for (auto it = m_mesh_cache.begin(); it != m_mesh_cache.end();) {
+      if (!it->second.used) {
+        release(it->second);
+        it = m_mesh_cache.erase(it);
+      } else {
+        ++it;
+      }
     }
     std::vector<StrandDraw> strands;
     clear_cpu_hair();
@@ -582,7 +603,7 @@ class GlRenderer final : public Renderer {
         if (!d.item->cast_shadow) continue;
         set_mat4(m_depth_prog, "uModel", d.item->transform.matrix());
         glBindVertexArray(d.vao);
-        glDrawArrays(GL_TRIANGLES, 0, d.count);
+        glDrawElements(GL_TRIANGLES, d.count, GL_UNSIGNED_INT, nullptr);
       }
       glDisable(GL_POLYGON_OFFSET_FILL);
       glLineWidth(1.0f);
@@ -1025,7 +1046,7 @@ class GlRenderer final : public Renderer {
       glBindTexture(GL_TEXTURE_2D, texture(mat.normal_map, GL_RGB16F, GL_RGB, GL_FLOAT, true));
     }
     glBindVertexArray(d.vao);
-    glDrawArrays(GL_TRIANGLES, 0, d.count);
+    glDrawElements(GL_TRIANGLES, d.count, GL_UNSIGNED_INT, nullptr);
   }
 
   StrandDraw upload_strands(FrameObjects& fo, const StrandItem& item, std::size_t index,
@@ -1180,6 +1201,91 @@ class GlRenderer final : public Renderer {
     std::weak_ptr<const void> owner;
     GLuint tex = 0;
   };
+  // The vertex buffer of a mesh drawn in the previous frame, kept while the same mesh (same
+  // object, alive, same vertex colours) is drawn again: a still scene seen by a moving camera
+  // (the viewer) uploads nothing. A TriMesh behind a shared_ptr<const> is not changed in place.
+  struct MeshEntry {
+    std::weak_ptr<const geom::TriMesh> owner;
+    std::vector<Vec3f> colors;
+    GLuint vao = 0, buffer = 0, index_buffer = 0;
+    GLsizei count = 0;  // indices
+    bool used = false;
+  };
+  static void release(MeshEntry& e) {
+    if (e.vao) glDeleteVertexArrays(1, &e.vao);
+    if (e.buffer) glDeleteBuffers(1, &e.buffer);
+    if (e.index_buffer) glDeleteBuffers(1, &e.index_buffer);
+    e.buffer = e.index_buffer = e.vao = 0;
+  }
+  /// The vertex array (and its vertex count) of one mesh item: cached, or for a second item of
+  /// the same mesh with other colours in one frame, a one-frame buffer.
+  std::pair<GLuint, GLsizei> mesh_buffer(FrameObjects& fo, const MeshItem& item, std::size_t index,
+                                         Eigen::AlignedBox3d* shadow_box) {
+    auto it = m_mesh_cache.find(item.mesh.get());
+    if (it != m_mesh_cache.end() && it->second.used && it->second.colors != item.vertex_colors) {
+      const MeshArrays a = build_mesh_vertices(item, index, shadow_box);
+      const GLuint vao = fo.vao();
+      fo.buffer(GL_ARRAY_BUFFER, a.vertices.size() * sizeof(MeshVertex), a.vertices.data());
+      fo.buffer(GL_ELEMENT_ARRAY_BUFFER, a.indices.size() * sizeof(uint32_t), a.indices.data());
+      mesh_attribs();
+      return {vao, GLsizei(a.indices.size())};
+    }
+    if (it != m_mesh_cache.end() && it->second.owner.lock() == item.mesh &&
+        it->second.colors == item.vertex_colors) {
+      MeshEntry& e = it->second;
+      e.used = true;
+      if (shadow_box) {  // as build_mesh_vertices extends it: every face corner
+        const geom::TriMesh& m = *item.mesh;
+        for (const Vec3i& f : m.faces)
+          for (int k = 0; k < 3; ++k)
+            extend(*shadow_box, item.transform, m.positions[std::size_t(f[k])]);
+      }
+      return {e.vao, e.count};
+    }
+    if (it != m_mesh_cache.end()) {
+      release(it->second);
+      m_mesh_cache.erase(it);
+    }
+    const MeshArrays a = build_mesh_vertices(item, index, shadow_box);
+    const std::size_t vbytes = a.vertices.size() * sizeof(MeshVertex);
+    const std::size_t bytes = vbytes + a.indices.size() * sizeof(uint32_t);
+    check_memory("render", fmt::format("uploading {} of geometry", format_bytes(double(bytes))),
+                 double(bytes), "draw fewer strands (hair[].density_scale) or a smaller mesh");
+    MeshEntry e;
+    e.owner = item.mesh;
+    e.colors = item.vertex_colors;
+    glGenVertexArrays(1, &e.vao);
+    glBindVertexArray(e.vao);
+    glGenBuffers(1, &e.buffer);
+    glBindBuffer(GL_ARRAY_BUFFER, e.buffer);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vbytes), a.vertices.data(), GL_STATIC_DRAW);
+    glGenBuffers(1, &e.index_buffer);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e.index_buffer);  // recorded in the vertex array
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(a.indices.size() * sizeof(uint32_t)),
+                 a.indices.data(), GL_STATIC_DRAW);
+    if (const GLenum err = glGetError(); err != GL_NO_ERROR) {
+      release(e);
+      if (err == GL_OUT_OF_MEMORY)
+        fail("render: the GL driver ran out of memory uploading {} of geometry",
+             format_bytes(double(bytes)));
+      fail("render: OpenGL error 0x{:x} uploading {} of geometry", unsigned(err),
+           format_bytes(double(bytes)));
+    }
+    mesh_attribs();
+    e.count = GLsizei(a.indices.size());
+    e.used = true;
+    const MeshEntry& kept = m_mesh_cache[item.mesh.get()] = std::move(e);
+    return {kept.vao, kept.count};
+  }
+  static void mesh_attribs() {
+    const std::size_t s = sizeof(MeshVertex);
+    attrib(0, 3, s, offsetof(MeshVertex, pos));
+    attrib(1, 3, s, offsetof(MeshVertex, normal));
+    attrib(2, 2, s, offsetof(MeshVertex, uv));
+    attrib(3, 3, s, offsetof(MeshVertex, color));
+    attrib(4, 3, s, offsetof(MeshVertex, pu));
+    attrib(5, 3, s, offsetof(MeshVertex, pv));
+  }
 
   std::shared_ptr<spdlog::logger> m_log;
   std::unique_ptr<tbb::task_arena> m_arena;  // the CPU hair view pass's threads (ctx.threads())
@@ -1209,6 +1315,7 @@ class GlRenderer final : public Renderer {
   int m_fb_w = 0, m_fb_h = 0, m_out_w = 0, m_out_h = 0, m_shadow_size = 0;
   float m_line_width_range[2] = {1, 1};
   std::map<const void*, TexEntry> m_tex_cache;
+  std::map<const void*, MeshEntry> m_mesh_cache;
   std::unique_ptr<SplatPassGl> m_splat;
 };
 

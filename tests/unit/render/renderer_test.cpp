@@ -377,3 +377,39 @@ TEST_F(Renderer_, BadInputIsError) {
   // The renderer still works afterwards.
   EXPECT_EQ(renderer().render(sphere_scene(), small()).width(), 128);
 }
+
+TEST_F(Renderer_, MeshBuffersKeptBetweenFramesFollowTheirMeshAndColours) {
+  // The renderer keeps a mesh's vertex buffer while the same mesh is drawn again. A new mesh, new
+  // vertex colours, or two items of one mesh with different colours in one frame must still draw
+  // what they hold (a stale buffer would show the old colours or geometry).
+  RenderScene s = sphere_scene();
+  s.lights[0].cast_shadow = true;
+  const auto first = renderer().render(s, small());
+  EXPECT_TRUE(renderer().render(s, small()) == first);  // cached: same bytes
+  const std::size_t nv = s.meshes[0].mesh->positions.size();
+  s.meshes[0].vertex_colors.assign(nv, Vec3f(1.0f, 0.0f, 0.0f));  // red, same mesh object
+  const auto red = renderer().render(s, small());
+  EXPECT_GT(red.at(84, 64, 0), red.at(84, 64, 1) + 60);
+  // Two items of the same mesh, red on the left and green on the right, in one frame.
+  MeshItem green = s.meshes[0];
+  green.vertex_colors.assign(nv, Vec3f(0.0f, 1.0f, 0.0f));
+  s.meshes[0].transform = Affine3(Eigen::Translation3d(-1.1, 0, 0)) * Eigen::Scaling(0.5);
+  green.transform = Affine3(Eigen::Translation3d(1.1, 0, 0)) * Eigen::Scaling(0.5);
+  s.meshes.push_back(green);
+  const auto both = renderer().render(s, small());
+  maybe_save(both, "cache_two_items.png");
+  EXPECT_GT(both.at(30, 64, 0), both.at(30, 64, 1) + 30);    // left: red
+  EXPECT_GT(both.at(112, 64, 1), both.at(112, 64, 0) + 30);  // right: green
+  // A new mesh object (a smaller sphere): its own geometry, not the cached one.
+  RenderScene t = sphere_scene();
+  t.meshes[0].mesh = make_sphere(0.3);
+  const auto small_sphere = renderer().render(t, small());
+  auto covered = [&](const image::ImageRGBA8& img) {
+    int n = 0;
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x)
+        n += std::abs(luminance(img, x, y) - luminance(img, 2, 2)) > 5.0;
+    return n;
+  };
+  EXPECT_LT(covered(small_sphere), covered(first) / 4);  // 0.3^2 of the area, not the old sphere
+}
