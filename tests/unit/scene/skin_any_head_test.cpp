@@ -76,17 +76,6 @@ Json shipped_smile() {
   return j;
 }
 
-std::string rig_error(const Json& j) {
-  Context ctx(1);
-  try {
-    auto s = Session::from_json(j, scenes_dir(), "x.json", ctx);
-    (void)s.skin_mesh(0, 0);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 // Largest and mean distance between the first n vertices of two meshes.
 std::pair<double, double> vertex_gap(const geom::TriMesh& a, const geom::TriMesh& b,
                                      std::size_t n) {

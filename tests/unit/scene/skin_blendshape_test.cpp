@@ -70,17 +70,6 @@ Json ict_scene() {
   return j;
 }
 
-std::string rig_error(const Json& j) {
-  Context ctx(1);
-  try {
-    auto s = Session::from_json(j, scenes_dir(), "x.json", ctx);
-    (void)s.skin_mesh(0, 0);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
 }  // namespace
 
 TEST(SkinBlendshape, BrowRaiseFurrowsTheForeheadOfTheIctHead) {
