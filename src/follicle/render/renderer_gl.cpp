@@ -53,14 +53,18 @@ struct FrameObjects {
   // "OpenGL error 0x505 during upload" after minutes), and an out-of-memory answer of the driver
   // is reported with the size instead of as a bare error code.
   GLuint buffer(GLenum target, std::size_t bytes, const void* data) {
+    return buffers.emplace_back(upload_buffer(target, bytes, data));
+  }
+  /// A new buffer object bound to `target` holding `bytes` of `data`; deleted again on failure.
+  static GLuint upload_buffer(GLenum target, std::size_t bytes, const void* data) {
     check_memory("render", fmt::format("uploading {} of geometry", format_bytes(double(bytes))),
                  double(bytes), "draw fewer strands (hair[].density_scale) or a smaller mesh");
     GLuint b = 0;
     glGenBuffers(1, &b);
-    buffers.push_back(b);
     glBindBuffer(target, b);
     glBufferData(target, GLsizeiptr(bytes), data, GL_STATIC_DRAW);
     const GLenum e = glGetError();
+    if (e != GL_NO_ERROR) glDeleteBuffers(1, &b);
     if (e == GL_OUT_OF_MEMORY)
       fail("render: the GL driver ran out of memory uploading {} of geometry",
            format_bytes(double(bytes)));
@@ -123,6 +127,13 @@ void extend(Eigen::AlignedBox3d& box, const Affine3& xf, const Vec3& p) {
   box.extend(xf * p);
 }
 
+/// Extends `box` by every face corner of the item's mesh, placed by its transform.
+void extend_by_faces(Eigen::AlignedBox3d& box, const MeshItem& item) {
+  const geom::TriMesh& m = *item.mesh;
+  for (const Vec3i& f : m.faces)
+    for (int k = 0; k < 3; ++k) extend(box, item.transform, m.positions[std::size_t(f[k])]);
+}
+
 /// The vertex and index arrays of a mesh: one vertex per distinct (position, UV) corner pair,
 /// so UV seams split vertices and nothing else does (every attribute is a function of that pair:
 /// the image is the one an unwelded corner array gives, with ~6x fewer vertex-shader runs).
@@ -134,8 +145,7 @@ struct MeshArrays {
 /// Builds the vertex arrays of a mesh. Normals: the mesh's own, else area-weighted face normals.
 /// Pu, Pv (dP/du, dP/dv) are averaged per UV vertex so the tangent frame is smooth within a UV
 /// chart.
-MeshArrays build_mesh_vertices(const MeshItem& item, std::size_t index,
-                               Eigen::AlignedBox3d* shadow_box) {
+MeshArrays build_mesh_vertices(const MeshItem& item, std::size_t index) {
   const geom::TriMesh& m = *item.mesh;
   const std::string where = fmt::format("render: meshes[{}] '{}'", index, m.name);
   const std::size_t nv = m.positions.size();
@@ -206,7 +216,6 @@ MeshArrays build_mesh_vertices(const MeshItem& item, std::size_t index,
       const std::size_t vi = std::size_t(m.faces[f][k]);
       const Vec3& p = m.positions[vi];
       if (!p.allFinite()) fail_at(where, "vertex {} is not finite", vi);
-      if (shadow_box) extend(*shadow_box, item.transform, p);
       const uint64_t key =
           uint64_t(vi) * (uint64_t(m.uvs.size()) + 1) + (uvs ? uint64_t(m.uv_faces[f][k]) + 1 : 0);
       const auto [it, fresh] = slot.try_emplace(key, uint32_t(out.vertices.size()));
@@ -1221,9 +1230,15 @@ class GlRenderer final : public Renderer {
   /// the same mesh with other colours in one frame, a one-frame buffer.
   std::pair<GLuint, GLsizei> mesh_buffer(FrameObjects& fo, const MeshItem& item, std::size_t index,
                                          Eigen::AlignedBox3d* shadow_box) {
+    const auto drawn = mesh_buffer(fo, item, index);  // checks the mesh when it builds arrays
+    if (shadow_box) extend_by_faces(*shadow_box, item);
+    return drawn;
+  }
+  std::pair<GLuint, GLsizei> mesh_buffer(FrameObjects& fo, const MeshItem& item,
+                                         std::size_t index) {
     auto it = m_mesh_cache.find(item.mesh.get());
     if (it != m_mesh_cache.end() && it->second.used && it->second.colors != item.vertex_colors) {
-      const MeshArrays a = build_mesh_vertices(item, index, shadow_box);
+      const MeshArrays a = build_mesh_vertices(item, index);
       const GLuint vao = fo.vao();
       fo.buffer(GL_ARRAY_BUFFER, a.vertices.size() * sizeof(MeshVertex), a.vertices.data());
       fo.buffer(GL_ELEMENT_ARRAY_BUFFER, a.indices.size() * sizeof(uint32_t), a.indices.data());
@@ -1232,44 +1247,28 @@ class GlRenderer final : public Renderer {
     }
     if (it != m_mesh_cache.end() && it->second.owner.lock() == item.mesh &&
         it->second.colors == item.vertex_colors) {
-      MeshEntry& e = it->second;
-      e.used = true;
-      if (shadow_box) {  // as build_mesh_vertices extends it: every face corner
-        const geom::TriMesh& m = *item.mesh;
-        for (const Vec3i& f : m.faces)
-          for (int k = 0; k < 3; ++k)
-            extend(*shadow_box, item.transform, m.positions[std::size_t(f[k])]);
-      }
-      return {e.vao, e.count};
+      it->second.used = true;
+      return {it->second.vao, it->second.count};
     }
     if (it != m_mesh_cache.end()) {
       release(it->second);
       m_mesh_cache.erase(it);
     }
-    const MeshArrays a = build_mesh_vertices(item, index, shadow_box);
-    const std::size_t vbytes = a.vertices.size() * sizeof(MeshVertex);
-    const std::size_t bytes = vbytes + a.indices.size() * sizeof(uint32_t);
-    check_memory("render", fmt::format("uploading {} of geometry", format_bytes(double(bytes))),
-                 double(bytes), "draw fewer strands (hair[].density_scale) or a smaller mesh");
+    const MeshArrays a = build_mesh_vertices(item, index);
     MeshEntry e;
     e.owner = item.mesh;
     e.colors = item.vertex_colors;
     glGenVertexArrays(1, &e.vao);
     glBindVertexArray(e.vao);
-    glGenBuffers(1, &e.buffer);
-    glBindBuffer(GL_ARRAY_BUFFER, e.buffer);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vbytes), a.vertices.data(), GL_STATIC_DRAW);
-    glGenBuffers(1, &e.index_buffer);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e.index_buffer);  // recorded in the vertex array
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(a.indices.size() * sizeof(uint32_t)),
-                 a.indices.data(), GL_STATIC_DRAW);
-    if (const GLenum err = glGetError(); err != GL_NO_ERROR) {
+    try {
+      e.buffer = FrameObjects::upload_buffer(
+          GL_ARRAY_BUFFER, a.vertices.size() * sizeof(MeshVertex), a.vertices.data());
+      // The element buffer binding is recorded in the vertex array.
+      e.index_buffer = FrameObjects::upload_buffer(
+          GL_ELEMENT_ARRAY_BUFFER, a.indices.size() * sizeof(uint32_t), a.indices.data());
+    } catch (...) {
       release(e);
-      if (err == GL_OUT_OF_MEMORY)
-        fail("render: the GL driver ran out of memory uploading {} of geometry",
-             format_bytes(double(bytes)));
-      fail("render: OpenGL error 0x{:x} uploading {} of geometry", unsigned(err),
-           format_bytes(double(bytes)));
+      throw;
     }
     mesh_attribs();
     e.count = GLsizei(a.indices.size());

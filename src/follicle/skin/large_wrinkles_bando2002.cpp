@@ -1,7 +1,9 @@
 #include "follicle/skin/large_wrinkles_bando2002.hpp"
 
 #include <algorithm>
+#include <bitset>
 #include <cmath>
+#include <map>
 
 #include "follicle/core/error.hpp"
 #include "follicle/core/parallel.hpp"
@@ -175,39 +177,31 @@ int WrinkleLayer::curve_island(const BezierDistance& bd) const {
   for (int k = 0; k < kSamples; ++k)
     q[std::size_t(k)] = bd.curve().eval(double(k) / (kSamples - 1));
   const Eigen::AlignedBox2d box = bd.bounds();
-  std::vector<std::pair<int, int>> hits;     // (island, sample)
-  std::vector<std::pair<int, double>> area;  // (island, 3D area of the holding faces)
+  // Per island: which samples its UV triangles hold, and the 3D area of those triangles.
+  std::map<int, std::pair<std::bitset<kSamples>, double>> held;
   for (std::size_t f = 0; f < m_rest.faces.size(); ++f) {
     const auto& t = m_tex.face_uv[f];
     Eigen::AlignedBox2d fb(t[0]);
     fb.extend(t[1]);
     fb.extend(t[2]);
     if (!fb.intersects(box)) continue;
-    bool any = false;
+    std::bitset<kSamples> in;
     for (int k = 0; k < kSamples; ++k)
-      if (fb.contains(q[std::size_t(k)]) && in_uv_triangle(t, q[std::size_t(k)])) {
-        hits.emplace_back(m_face_island[f], k);
-        any = true;
-      }
-    if (any) area.emplace_back(m_face_island[f], m_rest.face_area(f));
+      in[std::size_t(k)] = fb.contains(q[std::size_t(k)]) && in_uv_triangle(t, q[std::size_t(k)]);
+    if (in.none()) continue;
+    auto& h = held[m_face_island[f]];
+    h.first |= in;
+    h.second += m_rest.face_area(f);
   }
-  if (hits.empty()) return -1;
-  std::sort(hits.begin(), hits.end());
-  hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
-  std::sort(area.begin(), area.end());
-  int best = -1, best_count = 0;
+  int best = -1;
+  std::size_t best_count = 0;
   double best_area = 0;
-  for (std::size_t a = 0, b = 0; a < hits.size(); a = b) {
-    const int isl = hits[a].first;
-    while (b < hits.size() && hits[b].first == isl) ++b;
-    const int count = int(b - a);
-    double ar = 0;
-    for (const auto& [i2, x] : area)
-      if (i2 == isl) ar += x;
-    if (count > best_count || (count == best_count && ar > best_area)) {
-      best = isl;
+  for (const auto& [island, h] : held) {
+    const std::size_t count = h.first.count();
+    if (count > best_count || (count == best_count && h.second > best_area)) {
+      best = island;
       best_count = count;
-      best_area = ar;
+      best_area = h.second;
     }
   }
   return best;
