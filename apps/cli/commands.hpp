@@ -41,6 +41,16 @@ struct RenderArgs {
 };
 int run_render(const GlobalOptions& g, const RenderArgs& a);
 
+struct FitArgs {
+  std::string head;
+  std::string units = "m";
+  bool units_given = false;
+  std::string output;  // folder
+  std::vector<double> up, front;  // empty = found
+  int image_size = 800;
+};
+int run_fit(const GlobalOptions& g, const FitArgs& a);
+
 struct ValidateArgs {
   std::vector<std::string> scenes;
 };

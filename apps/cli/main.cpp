@@ -59,6 +59,22 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 16384));
   render->add_option("--frame", ra.frame, "frame number to render")->check(CLI::NonNegativeNumber);
 
+  FitArgs fa;
+  auto* fit = app.add_subcommand(
+      "fit", "fit the bundled face setup to another head: setup.json, scene.json, fit.png");
+  fit->add_option("head", fa.head, "head mesh (.obj, .ply, .gltf, .glb)")->required();
+  auto* fit_units =
+      fit->add_option("--units", fa.units, "length unit of the head file: mm, cm, dm, m")
+          ->capture_default_str();
+  fit->add_option("-o,--output", fa.output, "output folder")->required();
+  fit->add_option("--up", fa.up, "the head's up direction X Y Z in the file (else found)")
+      ->expected(3);
+  fit->add_option("--front", fa.front, "the direction the face looks, X Y Z (else found)")
+      ->expected(3);
+  fit->add_option("--image-size", fa.image_size, "fit.png width and height in pixels")
+      ->check(CLI::Range(64, 4096))
+      ->capture_default_str();
+
   ValidateArgs va;
   auto* validate =
       app.add_subcommand("validate", "check scene files strictly and load their assets");
@@ -198,6 +214,10 @@ int main(int argc, char** argv) {
       return run_info(g, ia);
     }
     if (*convert) return run_convert(g, ca);
+    if (*fit) {
+      fa.units_given = fit_units->count() > 0;
+      return run_fit(g, fa);
+    }
     if (*bench) return run_bench(g, ba);
     if (*docs) return run_docs(g, da);
     if (*exp) return run_export(g, ea);

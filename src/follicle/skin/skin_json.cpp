@@ -175,6 +175,10 @@ FaceSetup face_setup_from_json_text(const std::string& text, const std::string& 
     s.muscles.validate();
     for (const auto& w : s.wrinkles) w.validate();
     for (const auto& w : s.surface_wrinkles) w.validate();
+    if (s.up.norm() < 1e-9 || s.front.norm() < 1e-9 ||
+        s.up.normalized().cross(s.front.normalized()).norm() < 1e-3)
+      fail("up and front must be non-zero and not parallel, got [{}, {}, {}] and [{}, {}, {}]",
+           s.up.x(), s.up.y(), s.up.z(), s.front.x(), s.front.y(), s.front.z());
   } catch (const Error& e) {
     throw Error(file, e.what());
   }

@@ -20,6 +20,8 @@ struct FaceSetup {
   MuscleSet muscles;
   std::vector<LargeWrinkle> wrinkles;
   std::vector<SurfaceWrinkle> surface_wrinkles;
+  Vec3 up = Vec3::UnitY();     // the head's up in the mesh's frame (`follicle fit` finds it)
+  Vec3 front = Vec3::UnitZ();  // the direction the face looks
   template <class V>
   void visit(V&& v) {
     v("follicle_face", follicle_face, ParamInfo{"format version", "", 1, 1});
@@ -32,6 +34,13 @@ struct FaceSetup {
       ParamInfo{"large-scale wrinkles given by points on the skin (metres, the mesh's frame): "
                 "placed on whatever texture layout the mesh has or is given",
                 ""});
+    v("up", up,
+      ParamInfo{"the head's up direction in the mesh's frame (written by follicle fit; a record "
+                "of the fit, the scene's assets.meshes[].up is what hair and mapping use)",
+                "", -1e3, 1e3});
+    v("front", front,
+      ParamInfo{"the direction the face looks, mesh frame (written by follicle fit)", "", -1e3,
+                1e3});
   }
   static constexpr const char* kRequired[] = {"follicle_face", "muscles"};
 };
