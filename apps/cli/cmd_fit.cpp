@@ -34,28 +34,29 @@ int run_fit(const GlobalOptions& g, const FitArgs& a) {
   const double size = head.bounds().diagonal().norm();
   if (size < 0.05 || size > 2.0)
     ctx->log().warn(
-        "{}: the head is {:.3g} m across in {} — implausible for a head; is --units right?",
-        a.head, size, to_string(units));
+        "{}: the head is {:.3g} m across in {} — implausible for a head; is --units right?", a.head,
+        size, to_string(units));
   const auto fit = scene::fit_head(*ctx, tpl, head, up, front);
   progress.tick();
-  const auto out = scene::write_head_fit(*ctx, fit, a.head, units, scene::fit_mapping(fit, head), a.output,
-                                         a.image_size);
+  const auto out = scene::write_head_fit(*ctx, fit, a.head, units, scene::fit_mapping(fit, head),
+                                         a.output, a.image_size);
   progress.tick();
   progress.finish();
   const auto& s = fit.setup;
   fmt::print("orientation: up [{:.3f}, {:.3f}, {:.3f}], front [{:.3f}, {:.3f}, {:.3f}] ({})\n",
              s.up.x(), s.up.y(), s.up.z(), s.front.x(), s.front.y(), s.front.z(),
              fit.orientation_given ? "given" : "found");
-  fmt::print("scale: template x {:.4f}; rigid residual {:.2f} mm (overlap: {:.0f} % of the "
-             "template, {:.0f} % of the head)\n",
-             fit.rigid.s, fit.rigid_residual * 1e3, 100 * fit.overlap_template,
-             100 * fit.overlap_head);
-  fmt::print("registration residual: RMS {:.2f} mm, 95th percentile {:.2f} mm over {:.0f} % of "
-             "the template's vertices\n",
-             fit.residual_rms * 1e3, fit.residual_p95 * 1e3, 100 * fit.matched_fraction);
+  fmt::print(
+      "scale: template x {:.4f}; rigid residual {:.2f} mm (overlap: {:.0f} % of the "
+      "template, {:.0f} % of the head)\n",
+      fit.rigid.s, fit.rigid_residual * 1e3, 100 * fit.overlap_template, 100 * fit.overlap_head);
+  fmt::print(
+      "registration residual: RMS {:.2f} mm, 95th percentile {:.2f} mm over {:.0f} % of "
+      "the template's vertices\n",
+      fit.residual_rms * 1e3, fit.residual_p95 * 1e3, 100 * fit.matched_fraction);
   for (const auto& l : fit.landmarks)
-    fmt::print("  {:<9} [{:.4f}, {:.4f}, {:.4f}] m ({})\n", l.name, l.position.x(),
-               l.position.y(), l.position.z(), l.detected ? "found on the mesh" : "registered");
+    fmt::print("  {:<9} [{:.4f}, {:.4f}, {:.4f}] m ({})\n", l.name, l.position.x(), l.position.y(),
+               l.position.z(), l.detected ? "found on the mesh" : "registered");
   fmt::print("wrote {}, {}, {}\n", out.setup.string(), out.scene.string(), out.image.string());
   return 0;
 }

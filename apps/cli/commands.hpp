@@ -45,7 +45,7 @@ struct FitArgs {
   std::string head;
   std::string units = "m";
   bool units_given = false;
-  std::string output;  // folder
+  std::string output;             // folder
   std::vector<double> up, front;  // empty = found
   int image_size = 800;
 };

@@ -74,10 +74,10 @@ std::vector<Mat3> even_rotations(int n) {
   for (int i = 0; i < n; ++i) {
     const double s = i + 0.5, r = std::sqrt(s / n), R = std::sqrt(1.0 - s / n);
     const double alpha = 2 * kPi * s / phi, beta = 2 * kPi * s / psi;
-    out.push_back(Quat(R * std::cos(beta), r * std::sin(alpha), r * std::cos(alpha),
-                       R * std::sin(beta))
-                      .normalized()
-                      .toRotationMatrix());
+    out.push_back(
+        Quat(R * std::cos(beta), r * std::sin(alpha), r * std::cos(alpha), R * std::sin(beta))
+            .normalized()
+            .toRotationMatrix());
   }
   return out;
 }
@@ -95,8 +95,8 @@ Trim ficp_trim(const std::vector<double>& d_sorted, double min_overlap, double l
   std::size_t valid = 0;
   while (valid < n && std::isfinite(d_sorted[valid])) ++valid;
   if (valid == 0) return t;
-  const std::size_t k0 = std::min(valid, std::max<std::size_t>(
-                                             1, std::size_t(std::ceil(min_overlap * double(n)))));
+  const std::size_t k0 =
+      std::min(valid, std::max<std::size_t>(1, std::size_t(std::ceil(min_overlap * double(n)))));
   double sum = 0;
   for (std::size_t k = 1; k <= valid; ++k) {
     sum += d_sorted[k - 1] * d_sorted[k - 1];
@@ -116,8 +116,8 @@ struct Pairs {
 
 class RigidSolver {
  public:
-  RigidSolver(const Context& ctx, const TriMesh& source, const TriMesh& target,
-              const MeshQuery& sq, const MeshQuery& tq, const RigidRegistrationParams& p)
+  RigidSolver(const Context& ctx, const TriMesh& source, const TriMesh& target, const MeshQuery& sq,
+              const MeshQuery& tq, const RigidRegistrationParams& p)
       : m_ctx(ctx), m_source(source), m_target(target), m_sq(sq), m_tq(tq), m_p(p) {}
 
   struct Result {
@@ -146,10 +146,11 @@ class RigidSolver {
       };
       r.score = 3.0 - (2.0 * share(pb) + share(pa));
       const double na = double(ka.trim.keep), nb = double(kb.trim.keep);
-      r.residual = na + nb > 0 ? std::sqrt((ka.trim.rms * ka.trim.rms * na +
-                                            kb.trim.rms * kb.trim.rms * nb) /
-                                           (na + nb))
-                               : 0.0;
+      r.residual =
+          na + nb > 0
+              ? std::sqrt((ka.trim.rms * ka.trim.rms * na + kb.trim.rms * kb.trim.rms * nb) /
+                          (na + nb))
+              : 0.0;
       r.overlap_source = share(pa);
       r.overlap_target = share(pb);
       if (it == iterations || ka.trim.keep + kb.trim.keep < 4) break;
@@ -177,7 +178,8 @@ class RigidSolver {
       if (!dx.allFinite()) break;
       const Vec3 w = dx.head<3>();
       const double delta = std::clamp(dx[3], -0.2, 0.2);
-      const Mat3 Rw = w.norm() > 0 ? Mat3(Eigen::AngleAxisd(w.norm(), w.normalized())) : Mat3::Identity();
+      const Mat3 Rw =
+          w.norm() > 0 ? Mat3(Eigen::AngleAxisd(w.norm(), w.normalized())) : Mat3::Identity();
       Similarity next;
       next.R = Rw * xf.R;
       next.s = (1 + delta) * xf.s;
@@ -217,7 +219,8 @@ class RigidSolver {
   Pairs pair_source(const Similarity& xf, const Samples& a) const {
     Pairs p;
     const std::size_t n = a.p.size();
-    p.src.resize(n), p.dst.resize(n), p.n.resize(n), p.d.assign(n, std::numeric_limits<double>::infinity());
+    p.src.resize(n), p.dst.resize(n), p.n.resize(n),
+        p.d.assign(n, std::numeric_limits<double>::infinity());
     parallel_for(m_ctx, 0, n, [&](std::size_t i) {
       const auto cp = m_tq.closest_point(xf.apply(a.p[i]));
       p.src[i] = a.p[i];
@@ -234,7 +237,8 @@ class RigidSolver {
   Pairs pair_target(const Similarity& xf, const Samples& b) const {
     Pairs p;
     const std::size_t n = b.p.size();
-    p.src.resize(n), p.dst.resize(n), p.n.resize(n), p.d.assign(n, std::numeric_limits<double>::infinity());
+    p.src.resize(n), p.dst.resize(n), p.n.resize(n),
+        p.d.assign(n, std::numeric_limits<double>::infinity());
     parallel_for(m_ctx, 0, n, [&](std::size_t i) {
       const auto cp = m_sq.closest_point(xf.inverse(b.p[i]));
       p.dst[i] = b.p[i];
@@ -300,10 +304,10 @@ RigidRegistration register_rigid(const Context& ctx, const TriMesh& source, cons
   RigidRegistration out;
   const double s0 = fb.rms / fa.rms;
   const double scales[] = {1.0, 0.75, 1.0 / 0.75};
-  const Samples a1 = surface_samples(ctx, source, std::max<uint64_t>(50, params.samples / 5),
-                                     params.seed + 4);
-  const Samples b1 = surface_samples(ctx, target, std::max<uint64_t>(50, params.samples / 5),
-                                     params.seed + 5);
+  const Samples a1 =
+      surface_samples(ctx, source, std::max<uint64_t>(50, params.samples / 5), params.seed + 4);
+  const Samples b1 =
+      surface_samples(ctx, target, std::max<uint64_t>(50, params.samples / 5), params.seed + 5);
   for (std::size_t k = 0; k < starts.size(); ++k)
     for (double sc : scales) {
       Similarity xf;
@@ -392,11 +396,10 @@ NonrigidRegistration register_nonrigid(const Context& ctx, const TriMesh& source
 
   const int steps = params.steps;
   for (int step = 0; step < steps; ++step) {
-    const double alpha =
-        steps == 1 ? params.stiffness_end
-                   : params.stiffness_start *
-                         std::pow(params.stiffness_end / params.stiffness_start,
-                                  double(step) / double(steps - 1));
+    const double alpha = steps == 1 ? params.stiffness_end
+                                    : params.stiffness_start *
+                                          std::pow(params.stiffness_end / params.stiffness_start,
+                                                   double(step) / double(steps - 1));
     for (int round = 0; round < params.rounds_per_step; ++round) {
       current.positions = out.positions;
       current.compute_normals();
@@ -433,7 +436,8 @@ NonrigidRegistration register_nonrigid(const Context& ctx, const TriMesh& source
       if (solver.info() != Eigen::Success) fail("registration: the deformation system is singular");
       d = solver.solve(rhs);
       if (!d.allFinite()) fail("registration: the deformation diverged (non-finite positions)");
-      for (std::size_t i = 0; i < n; ++i) out.positions[i] = x0[i] + d.row(Eigen::Index(i)).transpose();
+      for (std::size_t i = 0; i < n; ++i)
+        out.positions[i] = x0[i] + d.row(Eigen::Index(i)).transpose();
     }
   }
 

@@ -57,7 +57,9 @@ Mat3 frame_rotation(const Vec3& up, const Vec3& front) {
   return dst;  // source axes are the identity
 }
 
-Json vec_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+Json vec_json(const Vec3& v) {
+  return Json::array({v.x(), v.y(), v.z()});
+}
 
 }  // namespace
 
@@ -70,9 +72,10 @@ HeadTemplate load_head_template(const std::filesystem::path& mesh, LengthUnit un
   const auto* eye_l = find_sphincter(t.setup, "orbicularis_oculi_L");
   const auto* eye_r = find_sphincter(t.setup, "orbicularis_oculi_R");
   if (!oris || !eye_l || !eye_r)
-    fail("{}: a fitting template needs the sphincters orbicularis_oris, orbicularis_oculi_L and "
-         "orbicularis_oculi_R (they locate its mouth and eyes)",
-         setup.string());
+    fail(
+        "{}: a fitting template needs the sphincters orbicularis_oris, orbicularis_oculi_L and "
+        "orbicularis_oculi_R (they locate its mouth and eyes)",
+        setup.string());
   const Vec3 mouth = oris->center, eyes = 0.5 * (eye_l->center + eye_r->center);
   const double mid_x = mouth.x();
 
@@ -129,8 +132,7 @@ HeadFit fit_head(const Context& ctx, const HeadTemplate& tpl, const geom::TriMes
       fail("fit: --up and --front must be non-zero and not parallel");
     R0 = frame_rotation(u, f);
   }
-  const auto rigid =
-      geom::register_rigid(ctx, tpl.region, head, params.rigid, R0 ? &*R0 : nullptr);
+  const auto rigid = geom::register_rigid(ctx, tpl.region, head, params.rigid, R0 ? &*R0 : nullptr);
   fit.rigid = rigid.xf;
   fit.rigid_residual = rigid.residual;
   fit.overlap_template = rigid.overlap_source;
@@ -139,7 +141,8 @@ HeadFit fit_head(const Context& ctx, const HeadTemplate& tpl, const geom::TriMes
   // The nose tip on the new head: its most frontal vertex within 2.5 cm (template) of where the
   // similarity puts the template's.
   const Vec3 front_new = fit.rigid.R * Vec3::UnitZ();
-  const Vec3 nose_guess = fit.rigid.apply(tpl.region.positions[std::size_t(tpl.landmarks[0].vertex)]);
+  const Vec3 nose_guess =
+      fit.rigid.apply(tpl.region.positions[std::size_t(tpl.landmarks[0].vertex)]);
   const double radius = 0.025 * fit.rigid.s;
   int nose = -1;
   for (std::size_t i = 0; i < head.num_vertices(); ++i)
@@ -147,10 +150,11 @@ HeadFit fit_head(const Context& ctx, const HeadTemplate& tpl, const geom::TriMes
         (nose < 0 || head.positions[i].dot(front_new) > head.positions[nose].dot(front_new)))
       nose = int(i);
   std::vector<geom::Landmark> constraints;
-  if (nose >= 0) constraints.push_back({tpl.landmarks[0].vertex, head.positions[std::size_t(nose)]});
+  if (nose >= 0)
+    constraints.push_back({tpl.landmarks[0].vertex, head.positions[std::size_t(nose)]});
 
-  const auto nr = geom::register_nonrigid(ctx, tpl.region, head, fit.rigid, constraints,
-                                          params.nonrigid);
+  const auto nr =
+      geom::register_nonrigid(ctx, tpl.region, head, fit.rigid, constraints, params.nonrigid);
   fit.residual_rms = nr.rms;
   fit.residual_p95 = nr.p95;
   fit.matched_fraction = nr.matched_fraction;
@@ -286,8 +290,18 @@ FitOutputs write_head_fit(const Context& ctx, const HeadFit& fit,
   view["render"]["width"] = image_size;
   view["render"]["height"] = image_size;
   view["render"]["supersample"] = 1;
-  // The session reads the setup from disk: write it first (it is valid on its own).
-  write_file_atomically(out.setup, skin::face_setup_to_json(fit.setup) + "\n");
+  // The session reads the setup from disk: a hidden copy until the render has worked, so a
+  // failure leaves no setup.json behind.
+  const fs::path staged = dir / ".setup.fit-staging.json";
+  write_file_atomically(staged, skin::face_setup_to_json(fit.setup) + "\n");
+  struct Remove {
+    fs::path p;
+    ~Remove() {
+      std::error_code e;
+      fs::remove(p, e);
+    }
+  } cleanup{staged};
+  view["skin"][0]["muscles"] = staged.filename().string();
   auto session = Session::from_json(view, dir, (dir / "scene.json").string(), ctx);
   const auto rs = session.render_scene(0);
   auto renderer = render::Renderer::create_headless(ctx);
@@ -326,6 +340,7 @@ FitOutputs write_head_fit(const Context& ctx, const HeadFit& fit,
   composite(img, carried, {1.0, 0.9, 0.1});
   composite(img, found, {0.2, 0.95, 0.3});
   image::write_png(out.image, img);
+  write_file_atomically(out.setup, skin::face_setup_to_json(fit.setup) + "\n");
   write_file_atomically(out.scene, scene.dump(2) + "\n");
   return out;
 }

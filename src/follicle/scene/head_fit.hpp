@@ -25,7 +25,7 @@ namespace follicle::scene {
 struct HeadTemplate {
   geom::TriMesh mesh;  // metres, y up, face towards +z, with the UVs its setup's wrinkles use
   skin::FaceSetup setup;
-  geom::TriMesh region;          // the registered part: the head above the neck (no shoulders)
+  geom::TriMesh region;            // the registered part: the head above the neck (no shoulders)
   std::vector<int> region_vertex;  // region vertex -> mesh vertex
   struct Mark {
     std::string name;
@@ -47,8 +47,8 @@ struct HeadFitParams {
 };
 
 struct HeadFit {
-  skin::FaceSetup setup;  // on the new head, metres in its frame; with up and front
-  geom::Similarity rigid;   // template -> new head
+  skin::FaceSetup setup;      // on the new head, metres in its frame; with up and front
+  geom::Similarity rigid;     // template -> new head
   double rigid_residual = 0;  // [m]
   double overlap_template = 0, overlap_head = 0;
   bool orientation_given = false;
