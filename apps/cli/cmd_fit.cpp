@@ -1,6 +1,7 @@
 // follicle fit HEAD --units U -o DIR [--up X Y Z --front X Y Z]: the bundled template's face
 // setup fitted to another head (scene/head_fit), with the registration's residual printed.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <filesystem>
 
@@ -57,6 +58,9 @@ int run_fit(const GlobalOptions& g, const FitArgs& a) {
   for (const auto& l : fit.landmarks)
     fmt::print("  {:<9} [{:.4f}, {:.4f}, {:.4f}] m ({})\n", l.name, l.position.x(), l.position.y(),
                l.position.z(), l.detected ? "found on the mesh" : "registered");
+  if (!fit.dropped_wrinkles.empty())
+    fmt::print("wrinkles left out (mostly beyond the head's surface): {}\n",
+               fmt::join(fit.dropped_wrinkles, ", "));
   fmt::print("wrote {}, {}, {}\n", out.setup.string(), out.scene.string(), out.image.string());
   return 0;
 }

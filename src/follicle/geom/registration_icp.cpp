@@ -126,7 +126,8 @@ class RigidSolver {
     double overlap_source = 0, overlap_target = 0;
   };
 
-  Result run(Similarity xf, const Samples& a, const Samples& b, int iterations) const {
+  Result run(Similarity xf, const Samples& a, const Samples& b, int iterations,
+             bool lock_rotation = false, bool lock_scale = false) const {
     Result r;
     for (int it = 0; it <= iterations; ++it) {
       Pairs pa = pair_source(xf, a), pb = pair_target(xf, b);
@@ -174,6 +175,18 @@ class RigidSolver {
       for (auto i : ka.idx) add(pa.src[i], pa.dst[i], pa.n[i]);
       for (auto i : kb.idx) add(pb.src[i], pb.dst[i], pb.n[i]);
       JtJ.diagonal().array() += 1e-9 * JtJ.diagonal().mean() + 1e-30;
+      if (lock_rotation) {  // scale and translation only
+        JtJ.topRows<3>().setZero();
+        JtJ.leftCols<3>().setZero();
+        JtJ.topLeftCorner<3, 3>().setIdentity();
+        Jtr.head<3>().setZero();
+      }
+      if (lock_scale) {
+        JtJ.row(3).setZero();
+        JtJ.col(3).setZero();
+        JtJ(3, 3) = 1;
+        Jtr[3] = 0;
+      }
       const Eigen::Matrix<double, 7, 1> dx = JtJ.ldlt().solve(-Jtr);
       if (!dx.allFinite()) break;
       const Vec3 w = dx.head<3>();
@@ -279,7 +292,15 @@ RigidRegistration register_rigid(const Context& ctx, const TriMesh& source, cons
   const MeshQuery sq(source), tq(target);
   RigidSolver solver(ctx, source, target, sq, tq, params);
   solver.set_source_size(mesh_size(source));
-  solver.set_inlier_distance(params.inlier_distance * mesh_size(target));
+  // A coarse mesh's facets stand off a smooth surface by a fraction of an edge: the inlier
+  // distance is at least half the target's mean edge length.
+  double edges = 0;
+  for (const auto& f : target.faces)
+    for (int k = 0; k < 3; ++k)
+      edges += (target.positions[std::size_t(f[k])] - target.positions[std::size_t(f[(k + 1) % 3])])
+                   .norm();
+  const double mean_edge = edges / (3.0 * double(target.num_faces()));
+  solver.set_inlier_distance(std::max(params.inlier_distance * mesh_size(target), 0.5 * mean_edge));
 
   // Phase 1: every start (orientation x scale) a few coarse rounds; phase 2: the best dozen
   // further at more samples; phase 3: the best three refined. Each start puts the source's
@@ -289,6 +310,7 @@ RigidRegistration register_rigid(const Context& ctx, const TriMesh& source, cons
   const Samples b = surface_samples(ctx, target, params.samples, params.seed + 1);
   const Frame fa = principal_frame(a.p), fb = principal_frame(b.p);
   std::vector<Mat3> starts;
+  const bool locked = initial_R != nullptr;  // rotation held through the search
   if (initial_R) {
     starts.push_back(*initial_R);
   } else {
@@ -314,15 +336,20 @@ RigidRegistration register_rigid(const Context& ctx, const TriMesh& source, cons
       xf.R = starts[k];
       xf.s = s0 * sc;
       xf.t = fb.centre - xf.s * (xf.R * fa.centre);
-      const auto r = solver.run(xf, a1, b1, 6);
-      out.start_scores.push_back(r.score);
-      tried.push_back({r.xf, r.score, initial_R ? -1 : int(k)});
+      // Each start twice: scale free, and scale held (the three start scales then search it:
+      // from a poor start a free scale can shrink the source onto a patch of the target, while
+      // a held one can keep a good start from converging in the few coarse rounds).
+      for (const bool hold : {false, true}) {
+        const auto r = solver.run(xf, a1, b1, 6, locked, hold);
+        out.start_scores.push_back(r.score);
+        tried.push_back({r.xf, r.score, initial_R ? -1 : int(k)});
+      }
     }
   const auto by_score = [](const Start& x, const Start& y) { return x.score < y.score; };
   std::stable_sort(tried.begin(), tried.end(), by_score);
-  tried.resize(std::min<std::size_t>(12, tried.size()));
+  tried.resize(std::min<std::size_t>(16, tried.size()));
   for (auto& t : tried) {
-    const auto r = solver.run(t.xf, a, b, params.iterations);
+    const auto r = solver.run(t.xf, a, b, params.iterations, locked, locked);
     t.xf = r.xf;
     t.score = r.score;
   }
@@ -332,7 +359,11 @@ RigidRegistration register_rigid(const Context& ctx, const TriMesh& source, cons
   const Samples fb_s = surface_samples(ctx, target, params.fine_samples, params.seed + 3);
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < std::min<std::size_t>(3, tried.size()); ++k) {
-    const auto r = solver.run(tried[k].xf, fa_s, fb_s, params.fine_iterations);
+    auto r = solver.run(tried[k].xf, fa_s, fb_s, params.fine_iterations);
+    // A given orientation is refined, not abandoned: when the free refinement turns more than
+    // 20 degrees away from it, the scale-and-translation fit stands.
+    if (locked && Eigen::AngleAxisd(r.xf.R * initial_R->transpose()).angle() > 20.0 * kPi / 180.0)
+      r = solver.run(tried[k].xf, fa_s, fb_s, params.fine_iterations, true);
     if (r.score < best) {
       best = r.score;
       out.xf = r.xf;

@@ -174,7 +174,10 @@ HeadFit fit_head(const Context& ctx, const HeadTemplate& tpl, const geom::TriMes
   }
 
   const skin::HeadMap map(tpl.region, nr.positions, fit.rigid, head);
-  fit.setup = skin::transfer_face_setup(tpl.setup, tpl.mesh, map, "fit");
+  // A wrinkle point is off the head where the deformed template lies more than 3 mm (template
+  // scale) from it: past a face mask's rim.
+  fit.setup = skin::transfer_face_setup(tpl.setup, tpl.mesh, map, "fit", 0.003 * fit.rigid.s,
+                                        &fit.dropped_wrinkles);
   return fit;
 }
 

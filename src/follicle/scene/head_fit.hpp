@@ -60,7 +60,8 @@ struct HeadFit {
     bool detected = false;         // found on the mesh (true) or carried by the registration
   };
   std::vector<Landmark> landmarks;
-  std::vector<Vec3> deformed_region;  // the template region on the new head
+  std::vector<std::string> dropped_wrinkles;  // template wrinkles mostly off the new head
+  std::vector<Vec3> deformed_region;          // the template region on the new head
 };
 
 /// Fits the template to `head` (metres). `up`/`front` (the head's, in its frame) replace the

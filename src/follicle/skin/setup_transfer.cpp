@@ -29,7 +29,8 @@ HeadMap::HeadMap(const geom::TriMesh& region, std::vector<Vec3> deformed,
 HeadMap::~HeadMap() = default;
 HeadMap::HeadMap(HeadMap&&) noexcept = default;
 
-Vec3 HeadMap::skin_point(const Vec3& p) const {
+Vec3 HeadMap::skin_point(const Vec3& p, double* gap) const {
+  if (gap) *gap = 0;
   const auto cp = m_impl->region_query.closest_point(p);
   if (cp.face < 0) return inner_point(p);
   const auto& f = m_region.faces[std::size_t(cp.face)];
@@ -39,6 +40,7 @@ Vec3 HeadMap::skin_point(const Vec3& p) const {
   for (int k = 0; k < 3; ++k) q += cp.bary[k] * m_deformed[std::size_t(f[k])];
   const auto on = m_impl->target_query.closest_point(q);
   if (on.face < 0) return q;
+  if (gap) *gap = on.distance;
   Vec3 n1 = m_target.face_normal(std::size_t(on.face));
   // Keep the side: the template's outward normal turned by the map (a target with the other
   // winding has face normals pointing in).
@@ -64,7 +66,8 @@ Vec3 HeadMap::inner_point(const Vec3& p) const {
 }
 
 FaceSetup transfer_face_setup(const FaceSetup& setup, const geom::TriMesh& template_mesh,
-                              const HeadMap& map, const std::string& where) {
+                              const HeadMap& map, const std::string& where, double edge_gap,
+                              std::vector<std::string>* dropped) {
   FaceSetup out;
   out.follicle_face = setup.follicle_face;
   out.muscles.expressions = setup.muscles.expressions;
@@ -104,7 +107,25 @@ FaceSetup transfer_face_setup(const FaceSetup& setup, const geom::TriMesh& templ
     lifted.insert(lifted.end(), w.begin(), w.end());
   }
   for (auto w : lifted) {
-    for (auto& p : w.points) p = map.skin_point(p);
+    // The longest run of points on the new head's surface.
+    std::size_t best_begin = 0, best_len = 0, begin = 0;
+    std::vector<Vec3> moved;
+    for (std::size_t i = 0; i < w.points.size(); ++i) {
+      double gap = 0;
+      moved.push_back(map.skin_point(w.points[i], &gap));
+      if (gap > edge_gap) {
+        begin = i + 1;
+      } else if (i + 1 - begin > best_len) {
+        best_begin = begin;
+        best_len = i + 1 - begin;
+      }
+    }
+    if (2 * best_len < w.points.size() || best_len < 2) {
+      if (dropped) dropped->push_back(w.name);
+      continue;
+    }
+    w.points.assign(moved.begin() + std::ptrdiff_t(best_begin),
+                    moved.begin() + std::ptrdiff_t(best_begin + best_len));
     w.depth = map.length(w.depth);
     w.width = map.length(w.width);
     out.surface_wrinkles.push_back(std::move(w));

@@ -38,7 +38,9 @@ class HeadMap {
   HeadMap& operator=(const HeadMap&) = delete;
 
   /// A point on or near the template's skin, to the new head's skin (keeping its height over it).
-  Vec3 skin_point(const Vec3& p) const;
+  /// `gap` (when given) receives how far the deformed template lies from the new head there [m]:
+  /// large where the template runs past the new head's edge (a forehead beyond a mask's rim).
+  Vec3 skin_point(const Vec3& p, double* gap = nullptr) const;
   /// A point inside the template (or anywhere): similarity plus the nearby displacement.
   Vec3 inner_point(const Vec3& p) const;
   Vec3 direction(const Vec3& v) const { return m_rigid.R * v; }
@@ -56,9 +58,13 @@ class HeadMap {
 
 /// The template's setup on the new head. `template_mesh` is the mesh the setup was made for
 /// (its UVs lift the texture-space wrinkles). Expressions and names are kept; the result's
-/// `up` and `front` are the template's turned by the map. Throws follicle::Error naming `where`
-/// when a wrinkle cannot be lifted.
+/// `up` and `front` are the template's turned by the map. A wrinkle point whose deformed
+/// template lies more than `edge_gap` from the new head is off its surface: a wrinkle keeps its
+/// longest run of points on it when that run holds at least half of them, and is dropped
+/// otherwise (named in `dropped`). Throws follicle::Error naming `where` when a wrinkle cannot
+/// be lifted.
 FaceSetup transfer_face_setup(const FaceSetup& setup, const geom::TriMesh& template_mesh,
-                              const HeadMap& map, const std::string& where);
+                              const HeadMap& map, const std::string& where, double edge_gap,
+                              std::vector<std::string>* dropped = nullptr);
 
 }  // namespace follicle::skin
