@@ -58,6 +58,11 @@ int run_fit(const GlobalOptions& g, const FitArgs& a) {
   for (const auto& l : fit.landmarks)
     fmt::print("  {:<9} [{:.4f}, {:.4f}, {:.4f}] m ({})\n", l.name, l.position.x(), l.position.y(),
                l.position.z(), l.detected ? "found on the mesh" : "registered");
+  if (!fit.whole_head())
+    fmt::print(
+        "a face mask (it covers {:.0f} % of the template's head): no scalp, so "
+        "scene.json has no hair\n",
+        100 * fit.overlap_template);
   if (!fit.dropped_wrinkles.empty())
     fmt::print("wrinkles left out (mostly beyond the head's surface): {}\n",
                fmt::join(fit.dropped_wrinkles, ", "));

@@ -56,10 +56,14 @@ struct TextureMappingParams {
                 "cylindrical"});
     v("harmonic", harmonic,
       ParamInfo{"minimize the projection's distortion with a harmonic map (Bando 2002 §2.4)"});
-    v("up", up, ParamInfo{"up direction in the mesh's frame (cylinder axis)", "", -1e3, 1e3});
+    v("up", up,
+      ParamInfo{"up direction in the mesh's frame (cylinder axis); in a scene, left at its "
+                "default it is the mesh asset's up",
+                "", -1e3, 1e3});
     v("front", front,
-      ParamInfo{"direction the face looks, mesh frame (the cylinder's seam is behind)", "", -1e3,
-                1e3});
+      ParamInfo{"direction the face looks, mesh frame (the cylinder's seam is behind); in a "
+                "scene, left at its default it is the mesh asset's front",
+                "", -1e3, 1e3});
     v("relax_iterations", relax_iterations,
       ParamInfo{"boundary relaxation sweeps before the harmonic solve", "", 0, 10000});
     v("relax_step", relax_step, ParamInfo{"relaxation step", "", 0.0, 1.0});

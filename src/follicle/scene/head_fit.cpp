@@ -225,7 +225,7 @@ Json fitted_scene_json(const HeadFit& fit, const std::string& head_path, LengthU
                  {"exponent", 120}}},
                {"render", {{"width_px", 0.7}, {"opacity", 1.0}, {"shadow", true}}},
                {"seed", 1}};
-  return Json{
+  Json scene{
       {"follicle_scene", 1},
       {"description",
        "Written by follicle fit: the bundled template's face setup fitted to this head "
@@ -244,6 +244,14 @@ Json fitted_scene_json(const HeadFit& fit, const std::string& head_path, LengthU
       {"skin", Json::array({rig})},
       {"hair", Json::array({hair})},
       {"outputs", Json::array({Json{{"type", "image"}, {"path", "fitted.png"}}})}};
+  if (!fit.whole_head()) {
+    scene.erase("hair");
+    scene["description"] =
+        "Written by follicle fit: the bundled template's face setup fitted to this face "
+        "(setup.json) and an expression that wrinkles the forehead. The mesh is a face mask "
+        "(no scalp), so the scene has no hair.";
+  }
+  return scene;
 }
 
 namespace {

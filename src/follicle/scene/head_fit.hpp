@@ -62,6 +62,10 @@ struct HeadFit {
   std::vector<Landmark> landmarks;
   std::vector<std::string> dropped_wrinkles;  // template wrinkles mostly off the new head
   std::vector<Vec3> deformed_region;          // the template region on the new head
+
+  /// A whole head (scalp and all) rather than a face mask: the new head covers at least 45 % of
+  /// the template's head and neck (measured: whole heads 67-100 %, masks 16-25 %).
+  bool whole_head() const { return overlap_template >= 0.45; }
 };
 
 /// Fits the template to `head` (metres). `up`/`front` (the head's, in its frame) replace the
@@ -73,7 +77,8 @@ HeadFit fit_head(const Context& ctx, const HeadTemplate& tpl, const geom::TriMes
 /// The scene `follicle fit` writes next to setup.json: the head (`head_path` as written in the
 /// scene, relative to its folder, in `units`, with the found up/front), the template's
 /// close-up camera and lights carried by the fit, a skin rig with `expression` and its wrinkles
-/// and a bob. `mapping` is the rig's texture space (fit_mapping).
+/// and a bob (none on a face mask, which has no scalp). `mapping` is the rig's texture space
+/// (fit_mapping).
 Json fitted_scene_json(const HeadFit& fit, const std::string& head_path, LengthUnit units,
                        const std::string& mapping, const std::string& expression = "troubled");
 

@@ -350,7 +350,14 @@ const skin::FaceRig& Session::face_rig(std::size_t ri) {
   const SkinSpec& s = m_scene.skin[ri];
   const std::string where = fmt::format("{}: skin[{}] (mesh \"{}\")", m_source, ri, s.mesh);
   const auto asset = mesh(mesh_index(s.mesh));
-  r.base = rig_base_mesh(asset, s.mapping, where, m_ctx->log());
+  // The mapping's axes default to the head's declared (or fitted) orientation.
+  geom::TextureMappingParams mapping = s.mapping;
+  const auto& a = m_scene.assets.meshes[mesh_index(s.mesh)];
+  if (mapping.up == Vec3::UnitY() && mapping.front == Vec3::UnitZ()) {
+    mapping.up = a.up;
+    mapping.front = a.front;
+  }
+  r.base = rig_base_mesh(asset, mapping, where, m_ctx->log());
   const geom::TriMesh& base = *r.base;
   const bool remapped = r.base != asset;
   if (remapped && !s.tissue.thickness_map.empty())

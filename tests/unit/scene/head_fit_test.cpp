@@ -347,3 +347,15 @@ TEST(HeadFit, WatersFaceIsFound) {
       skin::load_waters_geoface(test::shared_data_dir() / "waters-geoface/simpleface-1998");
   check_orientation(face.mesh, 15.0, "Waters");
 }
+
+TEST(HeadFit, AFaceMaskGetsNoHair) {
+  FOLLICLE_REQUIRE_SHARED("mediapipe-face/canonical_face_model.obj");
+  Context ctx(2);
+  const auto mask = geom::load_mesh(
+      test::shared_data_dir() / "mediapipe-face/canonical_face_model.obj", LengthUnit::cm);
+  const auto f = fit_head(ctx, tpl(), mask, std::nullopt, std::nullopt);
+  EXPECT_FALSE(f.whole_head());
+  EXPECT_FALSE(fitted_scene_json(f, "mask.obj", LengthUnit::cm, "uv").contains("hair"));
+  EXPECT_TRUE(self_fit().whole_head());
+  EXPECT_TRUE(fitted_scene_json(self_fit(), "head.obj", LengthUnit::mm, "uv").contains("hair"));
+}

@@ -228,3 +228,40 @@ TEST(SkinAnyHead, WhatCannotWorkFailsWithTheFix) {
   off["skin"][0]["add_surface_wrinkles"] = Json::array({w});
   EXPECT_THAT(rig_error(off), AllOf(HasSubstr("'floating'"), HasSubstr("mm from the skin")));
 }
+
+TEST(SkinAnyHead, TheMappingTakesTheHeadsDeclaredOrientation) {
+  // The bare head stored z up, facing -y, declared so in assets.meshes[].up/front, with its
+  // setup turned the same way: the rig's own texture layout (skin[].mapping left at its
+  // defaults) is the upright head's, because the cylinder axis and seam follow the declared
+  // orientation. Before, they stayed y and z and the layout was cut across the face.
+  const auto dir = test::scratch_dir("skin_any_head_turned");
+  const Mat3 R = Eigen::AngleAxisd(kPi / 2, Vec3::UnitX()).toRotationMatrix();  // y -> z
+  geom::TriMesh head = geom::load_mesh(bare().mesh, LengthUnit::mm);
+  for (auto& p : head.positions) p = R * p;
+  geom::save_mesh(head, dir / "turned.obj", LengthUnit::mm);
+  skin::FaceSetup s = skin::load_face_setup(bare().setup);
+  for (auto& m : s.muscles.linear) m.origin = R * m.origin, m.insertion = R * m.insertion;
+  for (auto& m : s.muscles.sphincter)
+    m.center = R * m.center, m.semi_axis_a = R * m.semi_axis_a, m.semi_axis_b = R * m.semi_axis_b;
+  auto& jaw = s.muscles.jaw;
+  jaw.pivot = R * jaw.pivot, jaw.axis = R * jaw.axis, jaw.plane_normal = R * jaw.plane_normal;
+  for (auto& w : s.surface_wrinkles)
+    for (auto& p : w.points) p = R * p;
+  std::ofstream(dir / "setup.json") << skin::face_setup_to_json(s);
+
+  Context ctx(1);
+  Json j = bare_smile();
+  j["assets"]["meshes"][0]["path"] = (dir / "turned.obj").string();
+  j["assets"]["meshes"][0]["up"] = {0, 0, 1};
+  j["assets"]["meshes"][0]["front"] = {0, -1, 0};
+  j["skin"][0]["muscles"] = (dir / "setup.json").string();
+  auto turned = Session::from_json(j, scenes_dir(), "turned.json", ctx);
+  auto upright = Session::from_json(bare_smile(), scenes_dir(), "bare.json", ctx);
+  const auto& a = turned.face_rig(0).rest_mesh();
+  const auto& b = upright.face_rig(0).rest_mesh();
+  ASSERT_EQ(a.uvs.size(), b.uvs.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < a.uvs.size(); ++i)
+    worst = std::max(worst, (a.uvs[i] - b.uvs[i]).norm());
+  EXPECT_LT(worst, 1e-6);
+}
