@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -134,6 +135,7 @@ TEST(HeadFit, AMirroredCopyGetsTheMirroredSetup) {
   // A rotation cannot mirror, so the template's left muscles land on the copy's left side: the
   // scan's own asymmetry (a few mm) is all that separates them from the mirrored original.
   const auto& orig = self_fit().setup;
+  double worst = 0;
   for (const auto& m : f.setup.muscles.linear) {
     std::string twin = m.name;
     if (twin.ends_with("_L"))
@@ -144,8 +146,10 @@ TEST(HeadFit, AMirroredCopyGetsTheMirroredSetup) {
                                  [&](const auto& o) { return o.name == twin; });
     ASSERT_NE(it, orig.muscles.linear.end());
     const Vec3 mirrored(-it->insertion.x(), it->insertion.y(), it->insertion.z());
+    worst = std::max(worst, (m.insertion - mirrored).norm());
     EXPECT_LT((m.insertion - mirrored).norm(), 8e-3) << m.name;
   }
+  std::printf("mirrored copy: insertions within %.2f mm of the mirrored original's\n", worst * 1e3);
 }
 
 TEST(HeadFit, AGivenOrientationAgreesWithTheFoundOne) {
@@ -178,9 +182,9 @@ struct SharedHead {
 // Fits `h`, checks the orientation (every shared head is y up, facing +z) and the nose tip, and
 // that the fitted rig with "troubled" furrows the forehead: the wrinkled skin differs from the
 // same rig without wrinkles above the eyes.
-void check_shared_head(const SharedHead& h, double tol_deg, double nose_tol) {
+void check_head_file(const std::filesystem::path& file, const SharedHead& h, double tol_deg,
+                     double nose_tol) {
   Context ctx(2);
-  const auto file = test::shared_data_dir() / h.path;
   const auto head = geom::load_mesh(file, h.units);
   const auto f = fit_head(ctx, tpl(), head, std::nullopt, std::nullopt);
   expect_upright(f.setup, tol_deg, 4.0, h.path);
@@ -205,6 +209,10 @@ void check_shared_head(const SharedHead& h, double tol_deg, double nose_tol) {
       below = std::max(below, d);
   }
   EXPECT_GT(forehead, 2e-4) << h.path << ": no furrow on the forehead";
+}
+
+void check_shared_head(const SharedHead& h, double tol_deg, double nose_tol) {
+  check_head_file(test::shared_data_dir() / h.path, h, tol_deg, nose_tol);
 }
 
 }  // namespace
@@ -333,6 +341,13 @@ TEST(HeadFit, MakeHumanHeadIsFound) {
       obj_group(test::shared_data_dir() / "makehuman-base/base.obj", "body", 6.2, 0.1);
   ASSERT_GT(head.num_faces(), 1000u);
   check_orientation(head, 15.0, "MakeHuman");
+  // Its rig furrows the forehead too (the crop saved as a file for the scene).
+  const auto file = test::scratch_dir("head_fit_makehuman") / "head.obj";
+  geom::save_mesh(head, file, LengthUnit::m);
+  Vec3 nose = head.positions[0];
+  for (const auto& p : head.positions)
+    if (p.z() > nose.z()) nose = p;
+  check_head_file(file, {"makehuman-base/base.obj", LengthUnit::m, nose}, 15.0, 4e-3);
 }
 
 TEST(HeadFit, CandideIsFound) {
