@@ -230,6 +230,13 @@ void LcpScenario::world(std::vector<Vec3>& x, std::vector<Vec3>* t) const {
   lcp_world(m_state, head_pose(), &x, nullptr, t);
 }
 
+void LcpScenario::restore(const LcpState& s) {
+  if (s.x.size() != m_state.x.size() || s.v.size() != s.x.size() || s.t.size() != s.x.size())
+    throw Error(fmt::format("lcp: a state of {} particles restored into a scenario of {}",
+                            s.x.size(), m_state.x.size()));
+  m_state = s;
+}
+
 LcpStepReport LcpScenario::step(const Context& ctx, double dt,
                                 const std::vector<Vec3>* extra_force) {
   LcpStepInput in;

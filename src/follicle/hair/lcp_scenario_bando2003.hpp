@@ -136,6 +136,10 @@ class LcpScenario {
   /// LcpSolver::use_simd (same results either way; for A/B benchmarks).
   void use_simd(bool on) { m_solver->use_simd(on); }
   const LcpState& state() const { return m_state; }  // head frame
+  /// Puts the hair back into an earlier state() of this scenario (its time included), e.g. to
+  /// replay the same frames (the air, if any, is not restored). Throws follicle::Error when the
+  /// particle count differs.
+  void restore(const LcpState& s);
   const geom::TriMesh& head() const { return m_head; }
   bool mesh_head() const { return m_mesh_head; }
   /// The collision body (head frame): voxel planes of the head (and torso).
