@@ -62,9 +62,11 @@ class LcpStepInstance : public WorkloadInstance {
     sp.spacing = 0.012 * std::cbrt(n0 / target);
     hair::LcpParams fp;
     if (frame && s.at("implicit") != 0) fp.integrator = "implicit";
-    const bool shake = frame && s.at("clip") != 0;
-    if (frame && s.at("clip") != 0 && s.at("clip") != 1)
-      fail("lcp-frame: size clip must be 0 (the fall) or 1 (the head shake), got {}", s.at("clip"));
+    if (frame) fp.implicit.speculative_contact = s.at("speculative") != 0;
+    const double clip = frame ? s.at("clip") : 0;
+    if (clip != 0 && clip != 1)
+      fail("lcp-frame: size clip must be 0 (the fall) or 1 (the head shake), got {}", clip);
+    const bool shake = clip == 1;
     if (shake) {  // Fig. 3.8: the settled hair on a head shaking about +y, 0.5 s per cycle
       sp.settle_time = 0.5;
       sp.shake = true;
@@ -199,8 +201,14 @@ void add_lcp_workloads(std::vector<Workload>& out) {
        "LCP hair (Bando 2003): one 1/60 s frame of the back hair, cycling through the first "
        "`frames` frames of a clip: clip=1 the settled hair in the head shake of Fig. 3.8, 0 its "
        "fall from the initial shape; implicit=1: the implicit integrator (ADR 0014), 0: "
-       "adaptive leapfrog sub-steps",
-       {{"particles", 2000}, {"simd", 1}, {"implicit", 1}, {"frames", 30}, {"clip", 1}},
+       "adaptive leapfrog sub-steps; speculative=0: the implicit sub-steps bounded by the contact "
+       "band instead of speculative contact (ADR 0016)",
+       {{"particles", 2000},
+        {"simd", 1},
+        {"implicit", 1},
+        {"frames", 30},
+        {"clip", 1},
+        {"speculative", 1}},
        "particles/s",
        [](const Context& ctx, const Sizes& s) -> std::unique_ptr<WorkloadInstance> {
          return std::make_unique<LcpStepInstance>(ctx, s, true);

@@ -74,12 +74,19 @@ struct LcpImplicitParams {
   double cfl = 1.0;          // largest displacement per sub-step / h
   double tolerance = 1e-2;   // conjugate gradients stop at |r| <= tolerance |b|
   int max_iterations = 200;  // conjugate-gradient iteration cap per sub-step
+  // Body contact on the velocity predicted at the sub-step's end, against the planes where the
+  // particle is and where it would go (sim::body_contact_accel_speculative, ADR 0016): sub-steps
+  // need not keep particles within the contact band. false: the band bounds the sub-step while
+  // any particle touches the body (the rule of ADR 0014).
+  bool speculative_contact = true;
   template <class V>
   void visit(V&& v) {
     v("min_substeps", min_substeps, ParamInfo{"minimum implicit sub-steps per step", "", 1, 10000});
     v("cfl", cfl, ParamInfo{"largest displacement per sub-step / h", "", 0.01, 4});
     v("tolerance", tolerance, ParamInfo{"relative residual of the linear solve", "", 1e-12, 0.5});
     v("max_iterations", max_iterations, ParamInfo{"linear-solve iteration cap", "", 1, 100000});
+    v("speculative_contact", speculative_contact,
+      ParamInfo{"body contact on the predicted end-of-sub-step motion"});
   }
 };
 

@@ -317,9 +317,11 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
   while (true) {
     const double rem = in.dt - elapsed;
     const double v_est = (std::isfinite(vmax) ? vmax : 0.0) + accel * longest;
-    // With particles in contact the sub-step also keeps them within the contact band of (3.19):
-    // the velocity-level rule (3.20)-(3.24) sees a particle once per sub-step.
-    const double reach = in_contact ? std::min(IP.cfl * h, P.contact.threshold) : IP.cfl * h;
+    // Without speculative contact, particles in contact also stay within the contact band of
+    // (3.19) per sub-step: the velocity-level rule (3.20)-(3.24) sees a particle once per
+    // sub-step, and one that crosses the band in a sub-step is inside the body before it is seen.
+    const bool band_bound = in_contact && !IP.speculative_contact;
+    const double reach = band_bound ? std::min(IP.cfl * h, P.contact.threshold) : IP.cfl * h;
     double allowed = v_est > 0 ? std::min(longest, reach / v_est) : longest;
     // The body's repulsion (3.24) is applied explicitly: k_r dt^2 <= 1 while in contact.
     if (in_contact && P.contact.k_r > 0) allowed = std::min(allowed, 1 / std::sqrt(P.contact.k_r));
@@ -467,11 +469,33 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
         uint8_t c = 0;
         double pdepth = 0;
         if (P.body_collision && m_body) {
-          if (const sim::BodyPlane* pl = m_body->find(s.x[i])) {
-            const Vec3 ac = sim::body_contact_accel(*pl, s.x[i], s.v[i], a, dt, P.contact);
+          const sim::BodyPlane* pl = m_body->find(s.x[i]);
+          if (pl) {
+            const Vec3 ac =
+                IP.speculative_contact
+                    ? sim::body_contact_accel_speculative(*pl, s.x[i], s.v[i], a, dt, P.contact)
+                    : sim::body_contact_accel(*pl, s.x[i], s.v[i], a, dt, P.contact);
             if (ac.squaredNorm() > 0) c = 1;
             a += ac;
             pdepth = std::max(0.0, -(s.x[i] - pl->p).dot(pl->n));
+          }
+          // Speculative: the planes of the voxels along the predicted path, at half-voxel
+          // spacing (a sub-step may carry a particle a voxel or more: along a curved or concave
+          // surface, or through the one-voxel shell of planes into the empty inside).
+          if (IP.speculative_contact) {
+            const Vec3 path = (s.v[i] + a * dt) * dt;
+            const int samples = int(std::min(
+                16.0, std::ceil(path.norm() / (0.5 * m_body->voxel_size()) * (1 - 1e-12))));
+            const sim::BodyPlane* last = pl;
+            for (int k = 1; k <= samples; ++k) {
+              const sim::BodyPlane* pe = m_body->find(s.x[i] + (double(k) / samples) * path);
+              if (!pe || pe == last || pe == pl) continue;
+              last = pe;
+              const Vec3 ac =
+                  sim::body_contact_accel_speculative(*pe, s.x[i], s.v[i], a, dt, P.contact);
+              if (ac.squaredNorm() > 0) c = 1;
+              a += ac;
+            }
           }
         }
         ws.contact[i] = c;

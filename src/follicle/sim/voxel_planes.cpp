@@ -10,6 +10,16 @@
 
 namespace follicle::sim {
 
+namespace {
+// The cell of a key (VoxelPlanes::key inverted).
+Eigen::Vector3i unkey(uint64_t k) {
+  auto g = [](uint64_t v) { return int(v & 0x1FFFFFu) - (1 << 20); };
+  return Eigen::Vector3i(g(k), g(k >> 21), g(k >> 42));
+}
+constexpr int kFaceNeighbours[6][3] = {{-1, 0, 0}, {1, 0, 0},  {0, -1, 0},
+                                       {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
+}  // namespace
+
 uint64_t VoxelPlanes::key(const Eigen::Vector3i& c) {
   // 21 bits per axis, offset so negative cells stay distinct.
   auto f = [](int v) { return uint64_t(uint32_t(v + (1 << 20)) & 0x1FFFFFu); };
@@ -102,6 +112,40 @@ VoxelPlanes VoxelPlanes::build(const std::vector<const geom::TriMesh*>& meshes,
     pl.n = e.n / nn;
     vp.m_planes.emplace(k, pl);
   }
+  // Voxels the surface only clips at a corner or an edge may draw no sample and leave a hole in
+  // the shell, through which a particle passes into the empty inside unseen (a strand's tip in a
+  // head shake went 8.5 mm into a sphere head through one). An empty voxel that the plane of a
+  // sampled face neighbour passes through gets that plane, the nearest to its centre of those
+  // (edge and corner neighbours' planes extrapolate too far on a scanned head): the surface crosses
+  // it, sampling missed it. Each value depends on the sampled voxels only (the neighbours in a
+  // fixed order), not on any iteration order.
+  std::vector<uint64_t> empty_near;
+  std::vector<std::pair<uint64_t, BodyPlane>> filled;
+  for (const auto& [k, e] : acc) {
+    const Eigen::Vector3i c = unkey(k);
+    for (const auto& o : kFaceNeighbours) {
+      const uint64_t nk = key(c + Eigen::Vector3i(o[0], o[1], o[2]));
+      if (!acc.count(nk)) empty_near.push_back(nk);
+    }
+  }
+  std::sort(empty_near.begin(), empty_near.end());
+  empty_near.erase(std::unique(empty_near.begin(), empty_near.end()), empty_near.end());
+  for (const uint64_t k : empty_near) {
+    const Eigen::Vector3i c = unkey(k);
+    const Vec3 centre = (c.cast<double>() + Vec3::Constant(0.5)) * vp.m_size;
+    const BodyPlane* best = nullptr;
+    double best_d = 0;
+    for (const auto& o : kFaceNeighbours) {
+      const auto it = vp.m_planes.find(key(c + Eigen::Vector3i(o[0], o[1], o[2])));
+      if (it == vp.m_planes.end()) continue;
+      const BodyPlane& pl = it->second;
+      const double d = std::abs((centre - pl.p).dot(pl.n));
+      const double reach = 0.5 * vp.m_size * pl.n.cwiseAbs().sum();  // the cube's extent along n
+      if (d <= reach && (!best || d < best_d)) best = &pl, best_d = d;
+    }
+    if (best) filled.emplace_back(k, *best);
+  }
+  for (const auto& [k, pl] : filled) vp.m_planes.emplace(k, pl);
   vp.build_dense_index();
   return vp;
 }
@@ -110,10 +154,6 @@ void VoxelPlanes::build_dense_index() {
   m_dense.clear();
   m_dense_planes.clear();
   if (m_planes.empty()) return;
-  auto unkey = [](uint64_t k) {
-    auto g = [](uint64_t v) { return int(v & 0x1FFFFFu) - (1 << 20); };
-    return Eigen::Vector3i(g(k), g(k >> 21), g(k >> 42));
-  };
   Eigen::Vector3i lo = unkey(m_planes.begin()->first), hi = lo;
   for (const auto& [k, pl] : m_planes) {
     const Eigen::Vector3i c = unkey(k);
@@ -180,6 +220,16 @@ std::vector<BodyPlane> VoxelPlanes::planes() const {
   return out;
 }
 
+namespace {
+// (3.23) Coulomb friction against a normal stopping acceleration of magnitude fcn.
+Vec3 coulomb_friction(const Vec3& vt1, double fcn, double dt, double mu) {
+  const double vt1n = vt1.norm();
+  if (vt1n < mu * fcn * dt) return -vt1 / dt;   // sticking
+  if (vt1n > 0) return -mu * fcn * vt1 / vt1n;  // sliding
+  return Vec3::Zero();
+}
+}  // namespace
+
 Vec3 body_contact_accel(const BodyPlane& plane, const Vec3& x, const Vec3& v_rel, const Vec3& a,
                         double dt, const BodyContactParams& params) {
   const Vec3& n = plane.n;
@@ -193,16 +243,23 @@ Vec3 body_contact_accel(const BodyPlane& plane, const Vec3& x, const Vec3& v_rel
     const Vec3 fc = -an - vn / dt;  // (3.21) stop the particle at the surface (inelastic)
     out += fc;
     const Vec3 vt1 = vt + at * dt;  // (3.22) tangential velocity without friction
-    const double vt1n = vt1.norm();
-    const double fcn = fc.norm();
-    if (vt1n < params.mu * fcn * dt) {
-      out += -vt1 / dt;  // (3.23) sticking
-    } else if (vt1n > 0) {
-      out += -params.mu * fcn * vt1 / vt1n;  // (3.23) sliding
-    }
+    out += coulomb_friction(vt1, fc.norm(), dt, params.mu);
   }
   if (d < 0) out += -params.k_r * d * n;  // (3.24) repulsion (per unit mass)
   return out;
+}
+
+Vec3 body_contact_accel_speculative(const BodyPlane& plane, const Vec3& x, const Vec3& v_rel,
+                                    const Vec3& a, double dt, const BodyContactParams& params) {
+  const Vec3& n = plane.n;
+  const double d = (x - plane.p).dot(n);  // (3.19)
+  if (!(d >= params.threshold)) return body_contact_accel(plane, x, v_rel, a, dt, params);
+  const double vn1 = v_rel.dot(n) + a.dot(n) * dt;   // (3.20) normal velocity after the step
+  const double edge = -(d - params.threshold) / dt;  // the normal velocity reaching the edge
+  if (!(vn1 < edge)) return Vec3::Zero();
+  const double fcn = (edge - vn1) / dt;  // (3.21) on the approach beyond the edge
+  const Vec3 vt1 = (v_rel - v_rel.dot(n) * n) + (a - a.dot(n) * n) * dt;  // (3.22)
+  return fcn * n + coulomb_friction(vt1, fcn, dt, params.mu);
 }
 
 }  // namespace follicle::sim

@@ -89,4 +89,14 @@ class VoxelPlanes {
 Vec3 body_contact_accel(const BodyPlane& plane, const Vec3& x, const Vec3& v_rel, const Vec3& a,
                         double dt, const BodyContactParams& params);
 
+/// Speculative contact for a step of length dt (ADR 0016): body_contact_accel within the band;
+/// outside it, a particle whose normal velocity after the step, v_n + a_n dt, would carry it past
+/// the band's edge is slowed to reach the edge at the step's end: (3.21) applied to the part of
+/// its approach beyond the edge, with (3.23)'s Coulomb friction on that impulse. With steps short
+/// enough that no particle crosses the band in one (the leapfrog's), it equals
+/// body_contact_accel; with longer steps a fast particle still stops at the band's edge instead
+/// of inside the body.
+Vec3 body_contact_accel_speculative(const BodyPlane& plane, const Vec3& x, const Vec3& v_rel,
+                                    const Vec3& a, double dt, const BodyContactParams& params);
+
 }  // namespace follicle::sim

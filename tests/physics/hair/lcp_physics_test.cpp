@@ -643,7 +643,9 @@ TEST(LcpImplicit, AHeadShakeAndTheTopOfTheWindRangeRun) {
     ASSERT_TRUE(rep.ok) << rep.message;
     subs += rep.substeps;
     for (std::size_t i = 0; i < s.x.size(); ++i)
-      if (!sc.init.model.root[i]) worst = std::max(worst, 0.1 - s.x[i].norm());
+      if (!sc.init.model.root[i]) {
+        worst = std::max(worst, 0.1 - s.x[i].norm());
+      }
   }
   std::printf("head shake, implicit: %d sub-steps in 45 frames, deepest penetration %.2f mm\n",
               subs, worst * 1e3);
