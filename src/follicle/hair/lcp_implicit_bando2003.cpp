@@ -489,7 +489,7 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
             const sim::BodyPlane* last = pl;
             for (int k = 1; k <= samples; ++k) {
               const sim::BodyPlane* pe = m_body->find(s.x[i] + (double(k) / samples) * path);
-              if (!pe || pe == last || pe == pl) continue;
+              if (!pe || pe == last) continue;  // a straight path enters each voxel once
               last = pe;
               const Vec3 ac =
                   sim::body_contact_accel_speculative(*pe, s.x[i], s.v[i], a, dt, P.contact);
