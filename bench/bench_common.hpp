@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "follicle/core/context.hpp"
+#include "follicle/core/resources.hpp"
 #include "workloads/workload.hpp"
 
 namespace follicle::bench {
@@ -16,6 +17,8 @@ namespace follicle::bench {
 inline void run_workload(benchmark::State& state, const char* name,
                          const workloads::Sizes& sizes = {}, int threads = 0) {
   using namespace follicle::workloads;
+  // As `follicle bench` does in main(): benchmark_main owns main() here.
+  follicle::keep_freed_heap_memory();
   Context ctx(threads);
   const auto all = all_workloads();
   const Workload& w = find_workload(all, name);

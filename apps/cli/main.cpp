@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "follicle/core/error.hpp"
 #include "follicle/core/interrupt.hpp"
+#include "follicle/core/resources.hpp"
 
 namespace {
 
@@ -36,6 +37,8 @@ int main(int argc, char** argv) {
   using namespace follicle::cli;
   // SIGINT / SIGTERM remove the temporary file of an output being written and stop ffmpeg.
   follicle::install_interrupt_handlers();
+  // Frames and simulation steps free and re-allocate the same memory (keep_freed_heap_memory).
+  follicle::keep_freed_heap_memory();
   CLI::App app{"follicle: model, animate and render virtual heads (skin wrinkles and hair)",
                "follicle"};
   app.require_subcommand(1);

@@ -7,9 +7,12 @@
 #include <exception>
 
 #include "follicle/core/error.hpp"
+#include "follicle/core/resources.hpp"
 #include "viewer_app.hpp"
 
 int main(int argc, char** argv) {
+  // Every frame frees and re-allocates the GL driver's memory (keep_freed_heap_memory).
+  follicle::keep_freed_heap_memory();
   follicle::viewer::ViewerOptions opt;
   CLI::App app{"follicle-viewer: interactive viewer for Follicle scene files", "follicle-viewer"};
   std::string scene, screenshot;

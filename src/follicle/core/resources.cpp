@@ -2,6 +2,9 @@
 
 #include <sys/resource.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -84,6 +87,19 @@ void check_memory(const std::string& where, std::string_view what, double bytes,
   if (std::isfinite(bytes) && bytes <= double(available)) return;
   fail_at(where, "{} needs about {} but this machine has {} available{}{}", what,
           format_bytes(bytes), format_bytes(double(available)), hint.empty() ? "" : "; ", hint);
+}
+
+bool keep_freed_heap_memory(std::size_t keep_bytes) {
+#if defined(__GLIBC__)
+  const int keep = int(std::min<std::size_t>(keep_bytes, std::size_t(1) << 30));
+  // M_MMAP_THRESHOLD: glibc's own upper bound for its dynamic threshold (32 MB on 64-bit);
+  // setting M_TRIM_THRESHOLD alone would freeze the threshold at its 128 KB start.
+  return mallopt(M_TRIM_THRESHOLD, keep) == 1 && mallopt(M_TOP_PAD, 16 << 20) == 1 &&
+         mallopt(M_MMAP_THRESHOLD, 32 << 20) == 1;
+#else
+  (void)keep_bytes;
+  return false;
+#endif
 }
 
 }  // namespace follicle

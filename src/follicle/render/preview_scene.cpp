@@ -5,16 +5,21 @@
 
 namespace follicle::render {
 
-geom::StrandSet every_kth_strand(const geom::StrandSet& s, std::size_t k) {
+geom::StrandSet every_kth_strand(const geom::StrandSet& s, std::size_t k, std::size_t m) {
   k = std::max<std::size_t>(k, 1);
+  m = std::max<std::size_t>(m, 1);
   geom::StrandSet out;
   const bool radius = !s.radius.empty(), color = !s.color.empty();
+  auto keep = [&](uint32_t p) {
+    out.points.push_back(s.points[p]);
+    if (radius) out.radius.push_back(s.radius[p]);
+    if (color) out.color.push_back(s.color[p]);
+  };
   for (std::size_t i = 0; i < s.num_strands(); i += k) {
-    for (uint32_t p = s.offsets[i]; p < s.offsets[i + 1]; ++p) {
-      out.points.push_back(s.points[p]);
-      if (radius) out.radius.push_back(s.radius[p]);
-      if (color) out.color.push_back(s.color[p]);
-    }
+    const uint32_t b = s.offsets[i], e = s.offsets[i + 1];
+    for (uint32_t p = b; p < e; p += uint32_t(m)) keep(p);
+    // The tip always stays, so the strand keeps its length.
+    if (e > b && (e - 1 - b) % m != 0) keep(e - 1);
     out.offsets.push_back(uint32_t(out.points.size()));
   }
   return out;
@@ -35,17 +40,17 @@ geom::ParticleSet every_kth_particle(const geom::ParticleSet& s, std::size_t k) 
 }
 
 namespace {
-// The reduced set of `src` for keep_every = k, from the cache when the source is unchanged.
+// The reduced set of `src` for the reduction `key`, from the cache when the source is unchanged.
 template <class T, class Entry, class Make>
 std::shared_ptr<const T> cached(std::vector<Entry>& cache, const std::shared_ptr<const T>& src,
-                                std::size_t k, Make&& make) {
+                                std::pair<std::size_t, std::size_t> key, Make&& make) {
   for (auto& e : cache)
-    if (!e.source.expired() && e.source.lock() == src && e.keep_every == k) return e.reduced;
-  auto r = std::make_shared<const T>(make(*src, k));
+    if (!e.source.expired() && e.source.lock() == src && e.key == key) return e.reduced;
+  auto r = std::make_shared<const T>(make(*src));
   cache.erase(
       std::remove_if(cache.begin(), cache.end(), [](const Entry& e) { return e.source.expired(); }),
       cache.end());
-  cache.push_back({src, k, r});
+  cache.push_back({src, key, r});
   if (cache.size() > 64) cache.erase(cache.begin());
   return r;
 }
@@ -57,19 +62,27 @@ void PreviewReducer::reduce(RenderScene& rs, RenderSettings& s, const PreviewPar
   s.height = std::max(1, int(std::lround(s.height * p.scale)));
   s.supersample = 1;
   s.shadow_map_size = std::min(s.shadow_map_size, p.shadow_map_size);
-  std::size_t strands = 0, particles = 0;
+  std::size_t strands = 0, points = 0, particles = 0;
   for (const auto& it : rs.strands)
-    if (it.strands) strands += it.strands->num_strands();
+    if (it.strands) {
+      strands += it.strands->num_strands();
+      points += it.strands->points.size();
+    }
   for (const auto& it : rs.particles)
     if (it.particles) particles += it.particles->size();
   const std::size_t ks = (strands + std::size_t(p.max_strands) - 1) / std::size_t(p.max_strands);
-  if (ks > 1) {
+  // Points per strand after that: every m-th while more than max_points remain.
+  const std::size_t kept_points = (points + ks - 1) / std::max<std::size_t>(ks, 1);
+  const std::size_t m = (kept_points + std::size_t(p.max_points) - 1) / std::size_t(p.max_points);
+  if (ks > 1 || m > 1) {
     // Thinner hair drawn wider: the strands that remain cover about what all of them did (up to
     // three times the width).
     const double widen = std::min(3.0, std::sqrt(double(ks)));
     for (auto& it : rs.strands) {
       if (!it.strands) continue;
-      it.strands = cached<geom::StrandSet>(m_strands, it.strands, ks, every_kth_strand);
+      it.strands = cached<geom::StrandSet>(
+          m_strands, it.strands, {ks, m},
+          [&](const geom::StrandSet& src) { return every_kth_strand(src, ks, m); });
       it.material.width_px *= widen;
     }
   }
@@ -78,7 +91,9 @@ void PreviewReducer::reduce(RenderScene& rs, RenderSettings& s, const PreviewPar
   if (kp > 1)
     for (auto& it : rs.particles) {
       if (!it.particles) continue;
-      it.particles = cached<geom::ParticleSet>(m_particles, it.particles, kp, every_kth_particle);
+      it.particles = cached<geom::ParticleSet>(
+          m_particles, it.particles, {kp, 1},
+          [&](const geom::ParticleSet& src) { return every_kth_particle(src, kp); });
       it.radius *= std::sqrt(double(kp));
     }
 }

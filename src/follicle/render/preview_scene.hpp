@@ -6,6 +6,7 @@
 // follicle-viewer and the `viewer-frame` benchmark workload.
 #include <cstddef>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "follicle/core/params.hpp"
@@ -16,12 +17,14 @@ namespace follicle::render {
 struct PreviewParams {
   double scale = 0.5;          // image size while moving / the view's size
   int max_strands = 12000;     // strands drawn while moving (over all strand items)
+  int max_points = 60000;      // strand points drawn while moving (every m-th along a strand)
   int max_particles = 20000;   // hair particles drawn while moving (over all particle items)
   int shadow_map_size = 1024;  // [texels] at most, while moving
   template <class V>
   void visit(V&& v) {
     v("scale", scale, ParamInfo{"image size while moving / view size", "", 0.1, 1.0});
     v("max_strands", max_strands, ParamInfo{"strands drawn while moving", "", 1, 1e8});
+    v("max_points", max_points, ParamInfo{"strand points drawn while moving", "", 2, 1e9});
     v("max_particles", max_particles, ParamInfo{"hair particles drawn while moving", "", 1, 1e8});
     v("shadow_map_size", shadow_map_size, ParamInfo{"shadow map while moving", "", 64, 16384});
   }
@@ -41,15 +44,16 @@ class PreviewReducer {
   template <class T>
   struct Entry {
     std::weak_ptr<const T> source;
-    std::size_t keep_every = 0;
+    std::pair<std::size_t, std::size_t> key;  // (every k-th item, every m-th point)
     std::shared_ptr<const T> reduced;
   };
   std::vector<Entry<geom::StrandSet>> m_strands;
   std::vector<Entry<geom::ParticleSet>> m_particles;
 };
 
-/// Every k-th strand of s (k >= 1), radii and colours kept.
-geom::StrandSet every_kth_strand(const geom::StrandSet& s, std::size_t k);
+/// Every k-th strand of s (k >= 1), and of each strand every m-th point from the root and the
+/// tip (m >= 1); radii and colours kept.
+geom::StrandSet every_kth_strand(const geom::StrandSet& s, std::size_t k, std::size_t m = 1);
 /// Every k-th particle of s (k >= 1), radii scaled by sqrt(k).
 geom::ParticleSet every_kth_particle(const geom::ParticleSet& s, std::size_t k);
 

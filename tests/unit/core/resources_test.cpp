@@ -4,10 +4,14 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "follicle/core/error.hpp"
 
@@ -63,3 +67,22 @@ TEST(Resources, TheSystemFigureIsPositiveAndNoMoreThanTheAddressSpaceLimit) {
   EXPECT_EQ(WEXITSTATUS(status), 0);
 #endif
 }
+
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)  // ASan brings its own allocator
+// keep_freed_heap_memory: a freed 8 MB block stays in the heap (the next frame reuses it)
+// instead of going back to the system. Without the policy glibc maps 8 MB on its own (above the
+// 128 KB start of its mmap threshold) and unmaps it at free.
+TEST(Resources, KeepFreedHeapMemoryKeepsAFreedFrameBufferInTheHeap) {
+  ASSERT_TRUE(follicle::keep_freed_heap_memory());
+  const std::size_t n = std::size_t(8) << 20;
+  const auto before = mallinfo2();
+  {
+    std::vector<char> frame(n, 1);
+    const auto during = mallinfo2();
+    EXPECT_EQ(during.hblkhd, before.hblkhd) << "an 8 MB block was mapped on its own";
+    EXPECT_GE(std::size_t(during.uordblks), std::size_t(before.uordblks) + n);
+  }
+  const auto after = mallinfo2();
+  EXPECT_GE(std::size_t(after.fordblks), n) << "the freed block went back to the system";
+}
+#endif

@@ -35,6 +35,39 @@ TEST(PreviewScene, EveryKthStrandKeepsWholeStrandsWithTheirColours) {
   EXPECT_EQ(every_kth_strand(*s, 1).points, s->points);
 }
 
+TEST(PreviewScene, EveryMthPointKeepsTheRootAndTheTip) {
+  const auto s = strands(4, 11);
+  const geom::StrandSet r = every_kth_strand(*s, 2, 3);  // strands 0, 2; points 0 3 6 9 10
+  ASSERT_EQ(r.num_strands(), 2u);
+  EXPECT_NO_THROW(r.check("reduced"));
+  for (std::size_t i = 0; i < 2; ++i) {
+    ASSERT_EQ(r.strand_size(i), 5u);
+    const uint32_t b = r.offsets[i];
+    EXPECT_EQ(r.points[b].y(), 0.0f);       // root
+    EXPECT_EQ(r.points[b + 3].y(), 9.0f);   // every third
+    EXPECT_EQ(r.points[b + 4].y(), 10.0f);  // tip
+    EXPECT_EQ(r.color[b].x(), float(2 * i) / 4);
+  }
+  // The tip is not repeated when the stride lands on it.
+  EXPECT_EQ(every_kth_strand(*strands(1, 10), 1, 3).points.size(), 4u);  // 0 3 6 9
+}
+
+TEST(PreviewScene, ReduceCapsThePointsDrawnAlongLongStrands) {
+  RenderScene rs;
+  StrandItem si;
+  si.strands = strands(5000, 40);  // 200,000 points in few strands
+  rs.strands.push_back(si);
+  RenderSettings s;
+  PreviewParams p;
+  PreviewReducer red;
+  red.reduce(rs, s, p);
+  const auto& r = *rs.strands[0].strands;
+  EXPECT_EQ(r.num_strands(), 5000u);  // under max_strands: all strands stay
+  EXPECT_LE(r.points.size(), std::size_t(p.max_points) + r.num_strands());  // + the tips
+  EXPECT_GE(r.points.size(), std::size_t(p.max_points) / 2);
+  EXPECT_EQ(r.points[r.offsets[1] - 1].y(), 39.0f);  // the tip stays
+}
+
 TEST(PreviewScene, ReduceCapsStrandsAndParticlesAndLowersTheSettings) {
   RenderScene rs;
   StrandItem si;
