@@ -1,4 +1,5 @@
-// follicle-viewer SCENE [--screenshot out.png [--frames N] [--with-ui]] [--width W --height H]
+// follicle-viewer SCENE [--frame F] [--screenshot out.png [--frames N] [--with-ui]] [--width W
+// --height H]
 //                 [--set PATH=VALUE ...] [--save edited.json]
 #include <fmt/format.h>
 
@@ -21,6 +22,9 @@ int main(int argc, char** argv) {
                  "batch mode: draw --frames frames, save the view to this PNG and exit");
   app.add_option("--frames", opt.frames, "frames to draw before the batch screenshot")
       ->check(CLI::Range(1, 100000));
+  app.add_option("--frame", opt.frame,
+                 "open at this timeline frame of an animated scene (as the panel's frame slider)")
+      ->check(CLI::Range(0, 10000000));
   app.add_flag("--with-ui", opt.screenshot_ui,
                "batch screenshot of the whole window with the panel");
   app.add_option("--width", opt.width, "window width")->check(CLI::Range(400, 16384));

@@ -327,8 +327,12 @@ class Viewer {
       m_session.emplace(std::move(s));
       m_error.clear();
       m_frame_count = std::max(1, m_session->frame_count());
+      if (initial) m_frame = m_opt.frame;
       m_frame = std::clamp(m_frame, 0, m_frame_count - 1);
       if (m_frame_count <= 1) m_playing = false;
+      if (initial && m_opt.frame >= m_frame_count)
+        m_error = fmt::format("--frame {}: the scene has {} frame(s), 0 to {}", m_opt.frame,
+                              m_frame_count, m_frame_count - 1);
       m_file_camera = m_session->render_scene(0).camera;
       if (initial || camera_changed) m_orbit.set_from(m_file_camera);
       m_edit = m_session->scene();
@@ -340,7 +344,7 @@ class Viewer {
       m_error = e.what();
       m_ctx.log().warn("{}", m_error);
     }
-    if (initial && m_session && !m_opt.sets.empty()) {
+    if (initial && m_session && !m_opt.sets.empty() && m_error.empty()) {
       try {
         scene::Json j = scene::write_scene(m_session->scene());
         for (const auto& a : m_opt.sets) apply_set(j, a);

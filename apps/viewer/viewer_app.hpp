@@ -20,6 +20,7 @@ struct ViewerOptions {
   std::vector<std::string> sets;
   std::filesystem::path save;  // batch mode: write the (edited) scene here before exiting
   bool preview = false;        // draw every frame as while the camera moves (batch checks)
+  int frame = 0;               // timeline frame to open at, as if the slider were moved there
 };
 
 /// Runs the viewer until the window closes (or the batch screenshot is written). Returns the
