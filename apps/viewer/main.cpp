@@ -1,6 +1,5 @@
-// follicle-viewer SCENE [--frame F] [--screenshot out.png [--frames N] [--with-ui]] [--width W
-// --height H]
-//                 [--set PATH=VALUE ...] [--save edited.json]
+// follicle-viewer SCENE [--frame F] [--screenshot out.png [--frames N] [--with-ui]]
+//                 [--width W --height H] [--set PATH=VALUE ...] [--save edited.json] [--preview]
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>

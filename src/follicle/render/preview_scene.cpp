@@ -70,9 +70,11 @@ void PreviewReducer::reduce(RenderScene& rs, RenderSettings& s, const PreviewPar
     }
   for (const auto& it : rs.particles)
     if (it.particles) particles += it.particles->size();
-  const std::size_t ks = (strands + std::size_t(p.max_strands) - 1) / std::size_t(p.max_strands);
-  // Points per strand after that: every m-th while more than max_points remain.
-  const std::size_t kept_points = (points + ks - 1) / std::max<std::size_t>(ks, 1);
+  // Every ks-th strand (at least 1: a scene without strands keeps its items as they are) ...
+  const std::size_t ks = std::max<std::size_t>(
+      1, (strands + std::size_t(p.max_strands) - 1) / std::size_t(p.max_strands));
+  // ... and of those every m-th point while more than max_points remain.
+  const std::size_t kept_points = (points + ks - 1) / ks;
   const std::size_t m = (kept_points + std::size_t(p.max_points) - 1) / std::size_t(p.max_points);
   if (ks > 1 || m > 1) {
     // Thinner hair drawn wider: the strands that remain cover about what all of them did (up to

@@ -68,6 +68,21 @@ TEST(PreviewScene, ReduceCapsThePointsDrawnAlongLongStrands) {
   EXPECT_EQ(r.points[r.offsets[1] - 1].y(), 39.0f);  // the tip stays
 }
 
+TEST(PreviewScene, AnEmptyStrandSetKeepsItsWidth) {
+  // An item without strands is left as it is: same set, same width (the strides are at least 1;
+  // before the review they relied on an unsigned wrap-around to come out 0 here).
+  RenderScene rs;
+  StrandItem si;
+  si.strands = std::make_shared<geom::StrandSet>();
+  si.material.width_px = 1.5;
+  rs.strands.push_back(si);
+  RenderSettings s;
+  PreviewReducer red;
+  red.reduce(rs, s, PreviewParams{});
+  EXPECT_EQ(rs.strands[0].material.width_px, 1.5);
+  EXPECT_EQ(rs.strands[0].strands.get(), si.strands.get());
+}
+
 TEST(PreviewScene, ReduceCapsStrandsAndParticlesAndLowersTheSettings) {
   RenderScene rs;
   StrandItem si;
