@@ -3,6 +3,7 @@ find_package(PkgConfig REQUIRED)
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(TBB REQUIRED)
 find_package(embree 3 REQUIRED)
+find_package(meshoptimizer REQUIRED)  # render: simplified meshes while the view moves
 pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
 find_package(tinyobjloader REQUIRED)
 find_package(TinyGLTF REQUIRED)

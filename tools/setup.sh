@@ -6,7 +6,7 @@ PKGS=(
   libeigen3-dev libembree-dev libtbb-dev libstb-dev libjpeg-dev libtinyobjloader-dev libtinygltf-dev
   nlohmann-json3-dev libopenexr-dev libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libegl-dev libopengl-dev libgl1-mesa-dri libglfw3-dev libimgui-dev
+  libegl-dev libopengl-dev libgl1-mesa-dri libglfw3-dev libimgui-dev libmeshoptimizer-dev
   xvfb xauth xdotool ffmpeg
   python3-dev pybind11-dev python3-numpy python3-pytest
   blender

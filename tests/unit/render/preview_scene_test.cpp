@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <set>
+#include <utility>
+
 #include "follicle/core/error.hpp"
 
 using namespace follicle;
@@ -137,4 +141,116 @@ TEST(PreviewScene, ReduceCapsStrandsAndParticlesAndLowersTheSettings) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("preview.scale"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+// A latitude-longitude sphere of radius r: positions shared across the UV seam at u = 0 / 1,
+// whose UVs are split there (as in an OBJ), poles included.
+std::shared_ptr<geom::TriMesh> uv_sphere(int nu, int nv, double r) {
+  auto m = std::make_shared<geom::TriMesh>();
+  auto pos = [&](int i, int j) {  // i around (mod nu), j from pole to pole
+    const double th = kPi * j / nv, ph = 2 * kPi * (i % nu) / nu;
+    return Vec3(r * std::sin(th) * std::cos(ph), r * std::cos(th), r * std::sin(th) * std::sin(ph));
+  };
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i < nu; ++i) m->positions.push_back(pos(i, j));
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) m->uvs.push_back(Vec2(double(i) / nu, 1.0 - double(j) / nv));
+  auto P = [&](int i, int j) { return j * nu + (i % nu); };
+  auto T = [&](int i, int j) { return j * (nu + 1) + i; };
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      if (j > 0) {
+        m->faces.push_back(Vec3i(P(i, j), P(i + 1, j), P(i, j + 1)));
+        m->uv_faces.push_back(Vec3i(T(i, j), T(i + 1, j), T(i, j + 1)));
+      }
+      if (j < nv - 1) {
+        m->faces.push_back(Vec3i(P(i + 1, j), P(i + 1, j + 1), P(i, j + 1)));
+        m->uv_faces.push_back(Vec3i(T(i + 1, j), T(i + 1, j + 1), T(i, j + 1)));
+      }
+    }
+  m->compute_normals();
+  return m;
+}
+}  // namespace
+
+TEST(PreviewScene, SimplifiedMeshKeepsTheShapeTheVerticesAndTheUvSeam) {
+  const auto m = uv_sphere(128, 64, 0.1);  // 16,128 faces
+  m->check("sphere");
+  const geom::TriMesh s = simplified_mesh(*m, 2000);
+  EXPECT_NO_THROW(s.check("simplified"));
+  EXPECT_LE(s.faces.size(), 2000u);
+  EXPECT_GE(s.faces.size(), 500u);
+  // The faces index the original vertices, which stay as they were.
+  EXPECT_EQ(s.positions, m->positions);
+  EXPECT_EQ(s.normals, m->normals);
+  EXPECT_EQ(s.uvs, m->uvs);
+  ASSERT_EQ(s.uv_faces.size(), s.faces.size());
+  // Every corner keeps a (position, UV) pair of the original mesh: no texture smeared across the
+  // seam; and the surface stays within 1 % of the radius of the sphere (face centroids).
+  std::set<std::pair<int, int>> pairs;
+  for (std::size_t f = 0; f < m->faces.size(); ++f)
+    for (int c = 0; c < 3; ++c) pairs.insert({m->faces[f][c], m->uv_faces[f][c]});
+  double area = 0, worst = 0;
+  for (std::size_t f = 0; f < s.faces.size(); ++f) {
+    for (int c = 0; c < 3; ++c)
+      EXPECT_TRUE(pairs.count({s.faces[f][c], s.uv_faces[f][c]})) << "face " << f;
+    const Vec3 g =
+        (s.positions[std::size_t(s.faces[f][0])] + s.positions[std::size_t(s.faces[f][1])] +
+         s.positions[std::size_t(s.faces[f][2])]) /
+        3;
+    worst = std::max(worst, 0.1 - g.norm());
+    area += s.face_area(f);
+  }
+  EXPECT_LT(worst, 0.1 * 0.03);
+  // No holes: the area stays close to the sphere's (a cracked seam or lost cap would show).
+  EXPECT_NEAR(area, 4 * kPi * 0.01, 4 * kPi * 0.01 * 0.03);
+  // A mesh within the budget is returned whole.
+  EXPECT_EQ(simplified_mesh(*m, 20000).faces, m->faces);
+  // Without UVs (and normals) as well: a scan straight from the scanner.
+  geom::TriMesh bare = *m;
+  bare.uvs.clear();
+  bare.uv_faces.clear();
+  bare.normals.clear();
+  const geom::TriMesh sb = simplified_mesh(bare, 2000);
+  EXPECT_NO_THROW(sb.check("simplified without UVs"));
+  EXPECT_LE(sb.faces.size(), 2000u);
+  EXPECT_TRUE(sb.uv_faces.empty());
+  EXPECT_TRUE(sb.has_normals());
+}
+
+TEST(PreviewScene, ReduceSimplifiesABigMeshOnceForItsTopology) {
+  const auto m = uv_sphere(128, 64, 0.1);
+  RenderSettings s;
+  PreviewParams p;
+  p.max_triangles = 2000;
+  PreviewReducer red;
+  RenderScene a;
+  MeshItem mi;
+  mi.mesh = m;
+  a.meshes.push_back(mi);
+  red.reduce(a, s, p);
+  const auto first = a.meshes[0].mesh;
+  EXPECT_LE(first->faces.size(), 2000u);
+  RenderScene b;
+  b.meshes.push_back(mi);
+  red.reduce(b, s, p);
+  EXPECT_EQ(b.meshes[0].mesh.get(), first.get());  // the same mesh again: reused
+  // The next frame of an animation: a new mesh object, same faces, moved vertices. The faces
+  // simplified before are reused; the new positions are drawn.
+  auto moved = std::make_shared<geom::TriMesh>(*m);
+  for (auto& q : moved->positions) q *= 1.5;
+  RenderScene c;
+  MeshItem mc;
+  mc.mesh = moved;
+  c.meshes.push_back(mc);
+  red.reduce(c, s, p);
+  EXPECT_EQ(c.meshes[0].mesh->faces, first->faces);
+  EXPECT_EQ(c.meshes[0].mesh->positions, moved->positions);
+  // Under the budget: the mesh itself.
+  p.max_triangles = 100000;
+  RenderScene d;
+  d.meshes.push_back(mi);
+  red.reduce(d, s, p);
+  EXPECT_EQ(d.meshes[0].mesh.get(), m.get());
 }
