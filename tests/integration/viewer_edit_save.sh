@@ -5,15 +5,7 @@
 # viewer showed it (within viewer_scenes.tolerance); a bad value is reported with its JSON path
 # while the last good scene stays on screen. Skips (exit 0) without xvfb-run or the viewer.
 source "$(dirname "$0")/lib/common.bash" "$@"
-VIEWER="$(dirname "$FOLLICLE")/../viewer/follicle-viewer"
-if ! command -v xvfb-run > /dev/null 2>&1; then
-  echo "SKIP: xvfb-run not installed"; exit 0
-fi
-if [ ! -x "$VIEWER" ]; then
-  echo "SKIP: follicle-viewer not built"; exit 0
-fi
-PNG="python3 $(dirname "$0")/lib/png_tools.py"
-read -r _ mean_max frac_max <<< "$(grep '^\* ' "$(dirname "$0")/viewer_scenes.tolerance")"
+source "$(dirname "$0")/lib/viewer.bash"
 SIZE=256
 view() {  # view SCENE OUT.png [viewer options...]
   local scene=$1 out=$2

@@ -5,15 +5,7 @@
 # "OpenGL error 0x501 during strand pass" (wide GL lines in its forward-compatible context).
 # Skips (exit 0) without xvfb-run or when the viewer is not built.
 source "$(dirname "$0")/lib/common.bash" "$@"
-VIEWER="$(dirname "$FOLLICLE")/../viewer/follicle-viewer"
-if ! command -v xvfb-run > /dev/null 2>&1; then
-  echo "SKIP: xvfb-run not installed"; exit 0
-fi
-if [ ! -x "$VIEWER" ]; then
-  echo "SKIP: follicle-viewer not built"; exit 0
-fi
-PNG="python3 $(dirname "$0")/lib/png_tools.py"
-TOL="$(dirname "$0")/viewer_scenes.tolerance"
+source "$(dirname "$0")/lib/viewer.bash"
 SIZE=256
 read -r _ def_mean def_frac <<< "$(grep '^\* ' "$TOL")"
 count=0

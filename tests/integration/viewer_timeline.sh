@@ -4,15 +4,7 @@
 # line of viewer_scenes.tolerance, and a different picture from frame 0; a frame beyond the
 # animation is an error naming the range. Skips (exit 0) without xvfb-run or the viewer.
 source "$(dirname "$0")/lib/common.bash" "$@"
-VIEWER="$(dirname "$FOLLICLE")/../viewer/follicle-viewer"
-if ! command -v xvfb-run > /dev/null 2>&1; then
-  echo "SKIP: xvfb-run not installed"; exit 0
-fi
-if [ ! -x "$VIEWER" ]; then
-  echo "SKIP: follicle-viewer not built"; exit 0
-fi
-PNG="python3 $(dirname "$0")/lib/png_tools.py"
-read -r _ mean_max frac_max <<< "$(grep '^\* ' "$(dirname "$0")/viewer_scenes.tolerance")"
+source "$(dirname "$0")/lib/viewer.bash"
 SIZE=256
 view() {  # scene frame out
   xvfb-run -a -s "-screen 0 1280x900x24" "$VIEWER" "$1" --frame "$2" --screenshot "$3" \
