@@ -7,6 +7,7 @@
 // anim::RigidSample given per step, which adds the inertial forces of §3.6 (the paper simulates
 // in the head frame too: "inertia force due to head movement"). Root particles (s < 0) and the
 // body's voxel planes stay fixed in that frame. world_positions() maps the state to the world.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -269,8 +270,16 @@ struct LcpWorkspace {
   std::vector<double> imp_spar, imp_sperp, imp_cpar;
   std::vector<Vec3> imp_pxh, imp_pdh;
   std::vector<double> imp_pk, imp_pc, imp_pf;
-  std::vector<Vec3> imp_dv, imp_r, imp_z, imp_p, imp_q, imp_b, imp_v0;
-  std::vector<Mat3> imp_dinv;    // inverse diagonal blocks (block-Jacobi preconditioner)
+  std::vector<Vec3> imp_dv, imp_r, imp_z, imp_p, imp_q, imp_b;
+  std::vector<Mat3> imp_dinv;  // inverse diagonal blocks (block-Jacobi preconditioner)
+  // The assembled rows of the system matrix (symmetric blocks xx yy zz xy xz yz): the diagonal
+  // block, the row's entries (column and block B, A_ij = -B) from LcpSolver::row_start on, their
+  // count, and S v0 of the sub-step's start velocities.
+  using Sym = std::array<double, 6>;
+  std::vector<Sym> imp_diag;
+  std::vector<std::array<float, 6>> imp_blk;
+  std::vector<uint32_t> imp_col, imp_len;
+  std::vector<Vec3> imp_sv;
   std::vector<double> imp_part;  // per-chunk partial sums of the dot products
 };
 
@@ -361,9 +370,12 @@ class LcpSolver {
   // Implicit sub-step pieces (lcp_implicit_bando2003.cpp).
   void implicit_blocks(const Context& ctx, const LcpState& s, LcpWorkspace& ws, double dt,
                        double drag) const;
-  void implicit_apply(const Context& ctx, LcpWorkspace& ws, const std::vector<Vec3>& u,
-                      std::vector<Vec3>& out, double ch, double sh, double drag_h,
-                      bool with_mass) const;
+  // out = A u over the assembled rows; returns u . out (summed in a fixed order).
+  double implicit_product(const Context& ctx, const LcpWorkspace& ws, const std::vector<Vec3>& u,
+                          std::vector<Vec3>& out) const;
+  // Where row i's entries start in ws.imp_col / ws.imp_blk (room for all its connections and
+  // listed neighbours).
+  std::size_t row_start(std::size_t i, const LcpWorkspace& ws, bool hh) const;
   /// Whether the Verlet lists still hold every pair within 2h, from ws.chunk_shift (may set
   /// ws.nbr_shift).
   bool lists_hold(const Context& ctx, const LcpState& s, LcpWorkspace& ws, double lim) const;

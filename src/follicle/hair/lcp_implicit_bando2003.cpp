@@ -46,9 +46,29 @@ double dot(const Context& ctx, const std::vector<Vec3>& a, const std::vector<Vec
       [](double x, double y) { return x + y; });
 }
 
-// The symmetric block a x x^T + b I applied to d.
-inline Vec3 rank1(const Vec3& x, double a, double b, const Vec3& d) {
-  return (a * x.dot(d)) * x + b * d;
+using Sym = LcpWorkspace::Sym;  // a symmetric 3x3 block: xx yy zz xy xz yz
+
+// B += a x x^T.
+inline void add_rank1(Sym& B, const Vec3& x, double a) {
+  B[0] += a * x.x() * x.x();
+  B[1] += a * x.y() * x.y();
+  B[2] += a * x.z() * x.z();
+  B[3] += a * x.x() * x.y();
+  B[4] += a * x.x() * x.z();
+  B[5] += a * x.y() * x.z();
+}
+
+template <class B6>
+inline Vec3 sym_mul(const B6& B, const Vec3& u) {
+  return Vec3(B[0] * u.x() + B[3] * u.y() + B[4] * u.z(),
+              B[3] * u.x() + B[1] * u.y() + B[5] * u.z(),
+              B[4] * u.x() + B[5] * u.y() + B[2] * u.z());
+}
+
+Mat3 sym_matrix(const Sym& B) {
+  Mat3 M;
+  M << B[0], B[3], B[4], B[3], B[1], B[5], B[4], B[5], B[2];
+  return M;
 }
 }  // namespace
 
@@ -133,87 +153,115 @@ void LcpSolver::implicit_blocks(const Context& ctx, const LcpState& s, LcpWorksp
         },
         1);
   }
-  // Block-Jacobi preconditioner: the inverse diagonal block of every particle's row.
+  // The rows of A = M (1 + dt drag) + dt C + dt^2 S, assembled once per sub-step so that every
+  // conjugate-gradient product is one pass over the particles (no per-connection / per-pair
+  // scatter and gather): A_ii = M_i (1 + dt drag) + sum_e B_e, A_ij = -B_e, with the symmetric
+  // block B_e = dt C_e + dt^2 S_e of each connection and interacting pair at i (each stored at
+  // both ends, computed from the same coefficients: the matrix is exactly symmetric). Row i's
+  // entries, in a fixed order: connections where i is the root-side end, where it is the
+  // tip-side end, then its listed neighbours in list order (those that interact). The same pass
+  // gives S v0 (for b) and the block-Jacobi preconditioner, the inverse of A_ii.
   ws.imp_dinv.resize(n);
+  ws.imp_diag.resize(n);
+  ws.imp_len.resize(n);
+  ws.imp_sv.resize(n);
+  const std::size_t cap =
+      m_ts_offsets[n] + m_rs_offsets[n] + (hh ? std::size_t(ws.nbr_offsets[n]) : 0);
+  ws.imp_col.resize(cap);
+  ws.imp_blk.resize(cap);
   const double h2 = dt * dt;
   parallel_chunks(ctx, n, kSolveChunk, [&](std::size_t i0, std::size_t i1) {
     for (std::size_t i = i0; i < i1; ++i) {
+      ws.imp_sv[i] = Vec3::Zero();
+      ws.imp_len[i] = 0;
       if (m.root[i]) {
         ws.imp_dinv[i] = Mat3::Identity();
+        ws.imp_diag[i] = Sym{1, 1, 1, 0, 0, 0};
         continue;
       }
-      Mat3 D = Mat3::Identity() * (m.mass[i] * (1 + dt * drag));
-      auto add_conn = [&](uint32_t q) {
-        const Vec3& xh = ws.conn_xh[q];
-        const double a = dt * ws.imp_cpar[q] + h2 * (ws.imp_spar[q] - ws.imp_sperp[q]);
-        D += a * xh * xh.transpose();
-        D.diagonal().array() += h2 * ws.imp_sperp[q];
+      const std::size_t base = row_start(i, ws, hh);
+      uint32_t len = 0;
+      Sym D{};
+      D[0] = D[1] = D[2] = m.mass[i] * (1 + dt * drag);
+      Vec3 sv = Vec3::Zero();
+      const Vec3& vi = s.v[i];
+      // One entry: B = bx x x^T + bd d d^T + bi I, S = sx x x^T + si I (S v0 for b).
+      auto put = [&](uint32_t col, const Vec3& x, double bx, const Vec3& dd, double bd, double bi,
+                     double sx, double si) {
+        Sym B{};
+        add_rank1(B, x, bx);
+        if (bd != 0) add_rank1(B, dd, bd);
+        B[0] += bi;
+        B[1] += bi;
+        B[2] += bi;
+        // The off-diagonal block is kept in single precision (half the memory traffic of the
+        // products; the solve stops at a relative residual of 1e-2): the diagonal sums the
+        // same rounded blocks, so A times a uniform velocity stays exactly M (1 + dt drag) u.
+        auto& Bf = ws.imp_blk[base + len];
+        for (int k = 0; k < 6; ++k) {
+          Bf[k] = float(B[k]);
+          D[k] += double(Bf[k]);
+        }
+        ws.imp_col[base + len] = col;
+        ++len;
+        const Vec3 d = vi - s.v[col];
+        sv += (sx * x.dot(d)) * x + si * d;
       };
-      for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e) add_conn(m_ts_pairs[e]);
-      for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) add_conn(m_rs_pairs[e]);
+      for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e) {
+        const uint32_t q = m_ts_pairs[e];
+        if (ws.imp_spar[q] == 0 && ws.imp_sperp[q] == 0 && ws.imp_cpar[q] == 0) continue;
+        const double sx = ws.imp_spar[q] - ws.imp_sperp[q];
+        put(m.pair_b[q], ws.conn_xh[q], dt * ws.imp_cpar[q] + h2 * sx, ws.conn_xh[q], 0,
+            h2 * ws.imp_sperp[q], sx, ws.imp_sperp[q]);
+      }
+      for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
+        const uint32_t q = m_rs_pairs[e];
+        if (ws.imp_spar[q] == 0 && ws.imp_sperp[q] == 0 && ws.imp_cpar[q] == 0) continue;
+        const double sx = ws.imp_spar[q] - ws.imp_sperp[q];
+        put(m.pair_a[q], ws.conn_xh[q], dt * ws.imp_cpar[q] + h2 * sx, ws.conn_xh[q], 0,
+            h2 * ws.imp_sperp[q], sx, ws.imp_sperp[q]);
+      }
       if (hh) {
-        for (uint32_t e = ws.nbr_offsets[i]; e < ws.nbr_offsets[i + 1]; ++e) {
-          const uint32_t sl = ws.nbr_pair[e];
+        const uint32_t e0 = ws.nbr_offsets[i], eu = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
+        const uint32_t p0 = ws.pair_off[i];  // pair slot of entry e >= eu: p0 + (e - eu)
+        for (uint32_t e = e0; e < e1; ++e) {
+          const uint32_t sl = e < eu ? ws.nbr_pair[e] : p0 + (e - eu);
           if (ws.imp_pk[sl] == 0 && ws.imp_pc[sl] == 0 && ws.imp_pf[sl] == 0) continue;
-          const Vec3& xh = ws.imp_pxh[sl];
-          const Vec3& dh = ws.imp_pdh[sl];
-          D += (h2 * ws.imp_pk[sl]) * xh * xh.transpose() +
-               (dt * (ws.imp_pc[sl] - ws.imp_pf[sl])) * dh * dh.transpose();
-          D.diagonal().array() += dt * ws.imp_pf[sl];
+          put(ws.nbrs[e], ws.imp_pxh[sl], h2 * ws.imp_pk[sl], ws.imp_pdh[sl],
+              dt * (ws.imp_pc[sl] - ws.imp_pf[sl]), dt * ws.imp_pf[sl], ws.imp_pk[sl], 0.0);
         }
       }
-      ws.imp_dinv[i] = D.inverse();
+      ws.imp_len[i] = len;
+      ws.imp_diag[i] = D;
+      ws.imp_sv[i] = sv;
+      ws.imp_dinv[i] = sym_matrix(D).inverse();
     }
   });
 }
 
-void LcpSolver::implicit_apply(const Context& ctx, LcpWorkspace& ws, const std::vector<Vec3>& u,
-                               std::vector<Vec3>& out, double ch, double sh, double drag_h,
-                               bool with_mass) const {
-  // out = (with_mass ? M (1 + drag_h) u : 0) + (ch C + sh S) u, root rows the identity (or 0).
-  // Per connection and per interacting pair the block times the difference of its ends, as the
-  // "force" on the root-side / lower-index end, then gathered per particle like the forces.
-  const auto& m = m_model;
-  const std::size_t n = m.size(), np = m.num_pairs();
-  const bool hh = m_params.hair_hair && ws.pair_off.size() == n + 1;
-  const std::size_t nconn = (np + kSolveChunk - 1) / kSolveChunk;
-  const std::size_t npc = hh ? ws.act_count.size() : 0;
-  parallel_for(
-      ctx, 0, nconn + npc,
-      [&](std::size_t c) {
-        if (c < nconn) {
-          const std::size_t q1 = std::min(np, (c + 1) * kSolveChunk);
-          for (std::size_t q = c * kSolveChunk; q < q1; ++q) {
-            const Vec3 d = u[m.pair_b[q]] - u[m.pair_a[q]];
-            const double sp = sh * ws.imp_sperp[q];
-            ws.spring_f[q] =
-                rank1(ws.conn_xh[q], ch * ws.imp_cpar[q] + sh * ws.imp_spar[q] - sp, sp, d);
-          }
-          return;
+std::size_t LcpSolver::row_start(std::size_t i, const LcpWorkspace& ws, bool hh) const {
+  return m_ts_offsets[i] + m_rs_offsets[i] + (hh ? std::size_t(ws.nbr_offsets[i]) : 0);
+}
+
+double LcpSolver::implicit_product(const Context& ctx, const LcpWorkspace& ws,
+                                   const std::vector<Vec3>& u, std::vector<Vec3>& out) const {
+  // out = A u over the rows assembled by implicit_blocks (root rows the identity); returns u . out.
+  const bool hh = m_params.hair_hair && ws.pair_off.size() == m_model.size() + 1;
+  return deterministic_reduce(
+      ctx, m_model.size(), kSolveChunk, 0.0,
+      [&](std::size_t i0, std::size_t i1) {
+        double uq = 0;
+        for (std::size_t i = i0; i < i1; ++i) {
+          Vec3 y = sym_mul(ws.imp_diag[i], u[i]);
+          const std::size_t base = row_start(i, ws, hh);
+          for (std::size_t e = base; e < base + ws.imp_len[i]; ++e)
+            y -= sym_mul(ws.imp_blk[e], u[ws.imp_col[e]]);
+          out[i] = y;
+          uq += u[i].dot(y);
         }
-        const std::size_t pc = c - nconn;
-        const std::size_t s0 = ws.pair_off[pc * kChunk];
-        for (std::size_t k = s0; k < s0 + ws.act_count[pc]; ++k) {
-          const uint32_t sl = ws.act_slot[k];
-          const Vec3 d = u[ws.act_j[k]] - u[ws.act_i[k]];
-          const double pf = ch * ws.imp_pf[sl];
-          ws.pair_f[sl] = rank1(ws.imp_pxh[sl], sh * ws.imp_pk[sl], 0.0, d) +
-                          rank1(ws.imp_pdh[sl], ch * ws.imp_pc[sl] - pf, pf, d);
-        }
+        return uq;
       },
-      1);
-  const detail::GatherInputs gin = gather_inputs(ws, hh);
-  parallel_chunks(ctx, n, kSolveChunk, [&](std::size_t i0, std::size_t i1) {
-    detail::lcp_gather(gin, i0, i1, out.data());
-    for (std::size_t i = i0; i < i1; ++i) {
-      if (m.root[i])
-        out[i] = with_mass ? u[i] : Vec3::Zero();
-      else if (with_mass)
-        out[i] = (m.mass[i] * (1 + drag_h)) * u[i] - out[i];
-      else
-        out[i] = -out[i];
-    }
-  });
+      [](double x, double y) { return x + y; });
 }
 
 LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& in, LcpState& s,
@@ -238,8 +286,7 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
     rep.message = "external force array size differs from the particle count";
     return rep;
   }
-  for (auto* v : {&ws.imp_dv, &ws.imp_r, &ws.imp_z, &ws.imp_p, &ws.imp_q, &ws.imp_b, &ws.imp_v0})
-    v->resize(n);
+  for (auto* v : {&ws.imp_dv, &ws.imp_r, &ws.imp_z, &ws.imp_p, &ws.imp_q, &ws.imp_b}) v->resize(n);
   ws.k.resize(np);
   ws.alpha.resize(np);
   ws.alpha_r.resize(n);
@@ -375,7 +422,6 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
     parallel_chunks(ctx, n, kChunk, [&](std::size_t i0, std::size_t i1) {
       detail::lcp_gather(gin, i0, i1, ws.force.data());
       for (std::size_t i = i0; i < i1; ++i) {
-        ws.imp_v0[i] = s.v[i];
         if (m.root[i]) continue;
         const double mi = m.mass[i];
         const Vec3 r = s.x[i] - piv;
@@ -389,7 +435,6 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
     });
     // 4. The matrix blocks, then b = dt f0 - dt^2 S v0.
     implicit_blocks(ctx, s, ws, dt, P.air_drag);
-    implicit_apply(ctx, ws, ws.imp_v0, ws.imp_q, 0.0, 1.0, 0.0, false);
     // The first guess: zero in a step's first sub-step; later ones start from the last
     // sub-step's dv scaled to this sub-step's length (the motion changes little between them),
     // which costs one product and saves more iterations than that. Only what this step() call
@@ -401,11 +446,11 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
         for (std::size_t i = i0; i < i1; ++i)
           ws.imp_dv[i] = m.root[i] ? Vec3::Zero() : Vec3(scale * ws.imp_dv[i]);
       });
-      implicit_apply(ctx, ws, ws.imp_dv, ws.imp_z, dt, dt * dt, dt * P.air_drag, true);
+      implicit_product(ctx, ws, ws.imp_dv, ws.imp_z);
     }
     parallel_chunks(ctx, n, kSolveChunk, [&](std::size_t i0, std::size_t i1) {
       for (std::size_t i = i0; i < i1; ++i) {
-        ws.imp_b[i] = m.root[i] ? Vec3::Zero() : Vec3(dt * ws.force[i] - dt * dt * ws.imp_q[i]);
+        ws.imp_b[i] = m.root[i] ? Vec3::Zero() : Vec3(dt * ws.force[i] - dt * dt * ws.imp_sv[i]);
         if (warm) {
           ws.imp_r[i] = ws.imp_b[i] - ws.imp_z[i];
         } else {
@@ -423,8 +468,7 @@ LcpStepReport LcpSolver::step_implicit(const Context& ctx, const LcpStepInput& i
     const double tol2 = IP.tolerance * IP.tolerance * bb;
     int it = 0;
     while (it < IP.max_iterations && rr > tol2 && bb > 0) {
-      implicit_apply(ctx, ws, ws.imp_p, ws.imp_q, dt, dt * dt, dt * P.air_drag, true);
-      const double pq = dot(ctx, ws.imp_p, ws.imp_q);
+      const double pq = implicit_product(ctx, ws, ws.imp_p, ws.imp_q);
       if (!(pq > 0)) break;  // not positive: the blocks are clamped, so only on non-finite input
       const double al = rz / pq;
       using Pair = std::pair<double, double>;
