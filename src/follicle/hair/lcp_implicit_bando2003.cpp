@@ -172,9 +172,9 @@ void LcpSolver::implicit_blocks(const Context& ctx, const LcpState& s, LcpWorksp
   const double h2 = dt * dt;
   parallel_chunks(ctx, n, kSolveChunk, [&](std::size_t i0, std::size_t i1) {
     for (std::size_t i = i0; i < i1; ++i) {
-      ws.imp_sv[i] = Vec3::Zero();
-      ws.imp_len[i] = 0;
       if (m.root[i]) {
+        ws.imp_sv[i] = Vec3::Zero();
+        ws.imp_len[i] = 0;
         ws.imp_dinv[i] = Mat3::Identity();
         ws.imp_diag[i] = Sym{1, 1, 1, 0, 0, 0};
         continue;
@@ -207,20 +207,16 @@ void LcpSolver::implicit_blocks(const Context& ctx, const LcpState& s, LcpWorksp
         const Vec3 d = vi - s.v[col];
         sv += (sx * x.dot(d)) * x + si * d;
       };
-      for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e) {
-        const uint32_t q = m_ts_pairs[e];
-        if (ws.imp_spar[q] == 0 && ws.imp_sperp[q] == 0 && ws.imp_cpar[q] == 0) continue;
+      auto put_conn = [&](uint32_t q, uint32_t partner) {
+        if (ws.imp_spar[q] == 0 && ws.imp_sperp[q] == 0 && ws.imp_cpar[q] == 0) return;
         const double sx = ws.imp_spar[q] - ws.imp_sperp[q];
-        put(m.pair_b[q], ws.conn_xh[q], dt * ws.imp_cpar[q] + h2 * sx, ws.conn_xh[q], 0,
+        put(partner, ws.conn_xh[q], dt * ws.imp_cpar[q] + h2 * sx, ws.conn_xh[q], 0,
             h2 * ws.imp_sperp[q], sx, ws.imp_sperp[q]);
-      }
-      for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e) {
-        const uint32_t q = m_rs_pairs[e];
-        if (ws.imp_spar[q] == 0 && ws.imp_sperp[q] == 0 && ws.imp_cpar[q] == 0) continue;
-        const double sx = ws.imp_spar[q] - ws.imp_sperp[q];
-        put(m.pair_a[q], ws.conn_xh[q], dt * ws.imp_cpar[q] + h2 * sx, ws.conn_xh[q], 0,
-            h2 * ws.imp_sperp[q], sx, ws.imp_sperp[q]);
-      }
+      };
+      for (uint32_t e = m_ts_offsets[i]; e < m_ts_offsets[i + 1]; ++e)
+        put_conn(m_ts_pairs[e], m.pair_b[m_ts_pairs[e]]);
+      for (uint32_t e = m_rs_offsets[i]; e < m_rs_offsets[i + 1]; ++e)
+        put_conn(m_rs_pairs[e], m.pair_a[m_rs_pairs[e]]);
       if (hh) {
         const uint32_t e0 = ws.nbr_offsets[i], eu = ws.nbr_upper[i], e1 = ws.nbr_offsets[i + 1];
         const uint32_t p0 = ws.pair_off[i];  // pair slot of entry e >= eu: p0 + (e - eu)
