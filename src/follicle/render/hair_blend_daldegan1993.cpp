@@ -204,8 +204,9 @@ void HairSegments::check(const std::string& where) const {
       fail_at(where, "point {} ({}, {}, {}) is not finite", i, points[i].x(), points[i].y(),
               points[i].z());
   for (std::size_t i = 0; i < radius.size(); ++i)
-    if (!(std::isfinite(radius[i]) && radius[i] >= 0))
-      fail_at(where, "radius {} of point {} is not a finite value >= 0", radius[i], i);
+    if (!(std::isfinite(radius[i]) && (radius[i] >= 0 || radius[i] == kNoRadius)))
+      fail_at(where, "radius {} of point {} is not a finite value >= 0 (or kNoRadius)", radius[i],
+              i);
   for (std::size_t s = 0; s < ns; ++s) {
     if (!(std::isfinite(width_px[s]) && width_px[s] > 0))
       fail_at(where, "width {} px of strand {} is not a finite value > 0", width_px[s], s);
@@ -263,7 +264,7 @@ void HairDepthRasterizer::rasterize(const Context& ctx, const HairSegments& hair
       w[0] = float((c.x() * 0.5 + 0.5) * n);
       w[1] = float((c.y() * 0.5 + 0.5) * n);
       w[2] = float(c.z() * 0.5 + 0.5);
-      w[3] = radii ? float(texels_per_m * double(hair.radius[i])) : 0.0f;
+      w[3] = radii && hair.radius[i] >= 0 ? float(texels_per_m * double(hair.radius[i])) : 0.0f;
     }
   });
   list_segments(
@@ -690,8 +691,8 @@ void HairBlender::prepare(const Context& ctx, const Mat4& view_proj, const HairS
           w.x = float((c.x() * iw * 0.5 + 0.5) * cell_w);
           w.y = float((c.y() * iw * 0.5 + 0.5) * cell_h);
           w.z = float(c.z() * iw * 0.5 + 0.5);
-          w.w_px =
-              radii ? float(2 * double(hair.radius[i]) * px_per_m * iw) : hair.width_px[st] * inv_k;
+          w.w_px = radii && hair.radius[i] >= 0 ? float(2 * double(hair.radius[i]) * px_per_m * iw)
+                                                : hair.width_px[st] * inv_k;
         }
       },
       64);

@@ -35,10 +35,14 @@ namespace follicle::render {
 struct HairSegments {
   std::vector<Vec3f> points;          // world [m]
   std::vector<uint32_t> offsets{0};   // strand s: points [offsets[s], offsets[s + 1])
-  std::vector<float> radius;          // per point [m]; empty: no world width (see width_px)
+  std::vector<float> radius;          // per point [m]; empty or kNoRadius: no world width
+                                      // there (the strand's width_px is used)
   std::vector<float> width_px;        // per strand: screen width [framebuffer px] without radius
   std::vector<float> opacity;         // per strand, [0, 1]
   std::vector<uint8_t> casts_shadow;  // per strand: 1 = drawn into the hair shadow buffers
+
+  /// A point of `radius` without a world width (when other strands have one).
+  static constexpr float kNoRadius = -1.0f;
 
   std::size_t num_strands() const { return offsets.size() - 1; }
   std::size_t num_points() const { return points.size(); }
@@ -47,7 +51,8 @@ struct HairSegments {
                   bool casts = true);
   /// Throws follicle::Error, prefixed by `where`, naming the first bad strand or point:
   /// offsets that do not start at 0, decrease or do not end at the point count; per-strand or
-  /// per-point arrays of the wrong size; a point that is not finite; a radius < 0; a width
+  /// per-point arrays of the wrong size; a point that is not finite; a radius < 0 other than
+  /// kNoRadius; a width
   /// <= 0; an opacity outside [0, 1] (or NaN).
   void check(const std::string& where) const;
 };

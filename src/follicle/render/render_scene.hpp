@@ -105,23 +105,27 @@ struct StrandMaterial {
   int shadow_filter_radius = 1;    // PCF box of (2 r + 1)^2 texels
 };
 
-/// Strands are drawn by GL lines/ribbons, except items with StrandShading::Daldegan1993 or
-/// hair_shadow, which go through the CPU shadow-buffer hair pass of Daldegan et al. 1993 §4
-/// (hair_blend_daldegan1993.hpp; docs/equations/daldegan_render.md): every light with
-/// cast_shadow gets a hair shadow buffer of the hair_shadow items, composed with the scene's
-/// (so that hair shadows the meshes, in the GL mesh pass for the first shadow light, and
-/// itself), and the hair is blended into the rendered scene as antialiased lines. Colours of
-/// that pass: Daldegan1993 and KajiyaKay shade with eq. (7) (K_A = ambient x colour, K_D =
-/// diffuse x colour, K_S = specular, n = shininess, S_i from each light's composite buffer);
-/// VertexColor keeps its colours c (e.g. Anjyo 1992 eq. 8-9) times (ambient + (1 - ambient) S)
-/// of the first shadow-casting light. cast_shadow concerns the GL shadow map only, which the
-/// CPU-pass items are not drawn into.
+/// Strands go through the CPU shadow-buffer hair pass of Daldegan et al. 1993 §4
+/// (hair_blend_daldegan1993.hpp; docs/equations/daldegan_render.md) when
+/// RenderSettings::strand_pass is "cpu" (the default) or the item has StrandShading::Daldegan1993
+/// or hair_shadow; otherwise ("gpu") they are GL lines/ribbons. In the CPU pass every light with
+/// cast_shadow gets a hair shadow buffer of the casting items (hair_shadow or cast_shadow),
+/// composed with the scene's (so that hair shadows the meshes, in the GL mesh pass for the
+/// first shadow light), and the hair is blended into the rendered scene as antialiased lines in
+/// depth order. Items with hair_shadow or Daldegan1993 shading are shadowed by those buffers
+/// (hair shadows itself); the others are lit without shadows, as the GL strand pass lights
+/// them. Colours of that pass: Daldegan1993 and KajiyaKay shade with eq. (7) (K_A = ambient x
+/// colour, K_D = diffuse x colour, K_S = specular, n = shininess, S_i from each light's
+/// composite buffer, 1 when unshadowed: the Kajiya-Kay terms of the GL pass); VertexColor keeps
+/// its colours c (e.g. Anjyo 1992 eq. 8-9), shadowed: times (ambient + (1 - ambient) S) of the
+/// first shadow-casting light. In the GL pass cast_shadow draws the item into the GL shadow
+/// map.
 struct StrandItem {
   std::shared_ptr<const geom::StrandSet> strands;
   Affine3 transform = Affine3::Identity();
   StrandMaterial material;
   bool cast_shadow = true;
-  bool hair_shadow = false;  // CPU pass, casting into the hair shadow buffers (see above)
+  bool hair_shadow = false;  // CPU pass, shadowed by and casting into the hair shadow buffers
 };
 
 enum class ParticleShading {
@@ -224,6 +228,11 @@ struct RenderSettings {
   /// read-back colour buffer on the CPU (docs/adr/0007-cpu-splat-view-pass.md; several times
   /// faster than a software GL rasteriser), "gpu" draws them with GL.
   std::string hair_view_pass = "cpu";
+  /// Strand items (StrandItem): "cpu" draws all of them with the CPU hair pass of Daldegan et
+  /// al. 1993 §4 (antialiased lines blended in depth order, hair_blend_daldegan1993.hpp;
+  /// docs/adr/0018-cpu-strand-pass.md: 2-3x faster than GL lines on a software rasteriser),
+  /// "gpu" draws those without Daldegan1993 shading or hair_shadow as GL lines / ribbons.
+  std::string strand_pass = "cpu";
 
   template <class V>
   void visit(V&& v) {
@@ -240,6 +249,8 @@ struct RenderSettings {
       ParamInfo{"depth slices of the \"gpu\" hair light-view pass", "", 1, 1 << 24});
     v("hair_view_pass", hair_view_pass,
       ParamInfo{"hair view pass: \"cpu\" (billboards blended on the CPU) or \"gpu\" (GL)"});
+    v("strand_pass", strand_pass,
+      ParamInfo{"strands: \"cpu\" (antialiased lines blended on the CPU) or \"gpu\" (GL lines)"});
   }
   void validate() const {
     validate_params(*this, "render");
@@ -247,9 +258,11 @@ struct RenderSettings {
       fail_at("render.hair_light_pass", "{}", e);
     if (const std::string e = hair_light_pass_error(hair_view_pass); !e.empty())
       fail_at("render.hair_view_pass", "{}", e);
+    if (const std::string e = hair_light_pass_error(strand_pass); !e.empty())
+      fail_at("render.strand_pass", "{}", e);
   }
-  /// Empty when `v` names a hair light-view or view pass ("cpu" or "gpu"), else what is wrong
-  /// with it (shared by the scene reader, which reports it at the JSON path).
+  /// Empty when `v` names a hair light-view, view or strand pass ("cpu" or "gpu"), else what is
+  /// wrong with it (shared by the scene reader, which reports it at the JSON path).
   static std::string hair_light_pass_error(const std::string& v) {
     if (v == "cpu" || v == "gpu") return {};
     return "unknown value \"" + v + "\"; expected \"cpu\" or \"gpu\"";

@@ -561,8 +561,8 @@ class GlRenderer final : public Renderer {
     for (std::size_t i = 0; i < scene.strands.size(); ++i) {
       const StrandItem& item = scene.strands[i];
       if (!item.strands || item.strands->points.empty()) continue;
-      if (is_cpu_hair(item)) {
-        gather_cpu_hair(item, i, k, item.hair_shadow ? sb : nullptr);
+      if (is_cpu_hair(item, settings)) {
+        gather_cpu_hair(item, i, k, item.hair_shadow || item.cast_shadow ? sb : nullptr);
         continue;
       }
       strands.push_back(upload_strands(fo, item, i, item.cast_shadow ? sb : nullptr));
@@ -625,9 +625,16 @@ class GlRenderer final : public Renderer {
       check_gl("shadow pass");
     };
     const bool cpu_hair = !m_hair_items.empty();
+    // Hair shadow buffers: every shadow light's when some item is shadowed by them, the mesh
+    // pass's light's also when some item only casts (onto the meshes).
+    const bool hair_shadowed =
+        std::any_of(m_hair_items.begin(), m_hair_items.end(),
+                    [](const CpuHairItem& h) { return is_shadowed_hair(*h.item); });
+    const bool hair_casts = std::any_of(m_hair.casts_shadow.begin(), m_hair.casts_shadow.end(),
+                                        [](uint8_t c) { return c != 0; });
     m_hair_shadow.resize(scene.lights.size());
     for (ShadowBuffer& b : m_hair_shadow) b.size = 0;  // none yet (the memory is kept)
-    if (shadows && cpu_hair) {
+    if (shadows && hair_shadowed) {
       // Daldegan 1993 §4 steps (1)-(3) for the other shadow-casting lights; they share the
       // shadow framebuffer, so they go first and the mesh pass's light comes last.
       for (std::size_t li = 0; li < scene.lights.size(); ++li) {
@@ -645,7 +652,7 @@ class GlRenderer final : public Renderer {
       shadow_depth_range = 3 * r;
       draw_shadow_casters(light_vp);
       // The composite buffer replaces the scene's, so the hair shadows the meshes (step 4).
-      if (cpu_hair)
+      if (hair_shadowed || hair_casts)
         hair_shadow_buffer(std::size_t(shadow_light), light_vp, settings.shadow_map_size, true);
       if (!m_splat->empty()) {
         SplatPassGl::Light sl;
@@ -759,8 +766,16 @@ class GlRenderer final : public Renderer {
 
   // ---- Daldegan 1993 §4 CPU hair pass ---------------------------------------------------------
 
-  static bool is_cpu_hair(const StrandItem& item) {
-    return item.material.shading == StrandShading::Daldegan1993 || item.hair_shadow;
+  static bool is_cpu_hair(const StrandItem& item, const RenderSettings& settings) {
+    return settings.strand_pass == "cpu" || item.material.shading == StrandShading::Daldegan1993 ||
+           item.hair_shadow;
+  }
+
+  /// Whether the CPU pass shades `item` with the shadow buffers (S_i of eq. 7, or the key
+  /// light's S of the shadowed vertex colours); the other items are lit without shadows, as
+  /// the GL strand pass lights them.
+  static bool is_shadowed_hair(const StrandItem& item) {
+    return item.hair_shadow || item.material.shading == StrandShading::Daldegan1993;
   }
 
   struct CpuHairItem {
@@ -801,11 +816,6 @@ class GlRenderer final : public Renderer {
     if (!mat.color.allFinite() || mat.color.minCoeff() < 0)
       fail_at(where + ".material.color", "must be finite and >= 0");
     if (!item.transform.matrix().allFinite()) fail_at(where, "the transform is not finite");
-    if (!m_hair_items.empty() && (s.radius.empty() != m_hair.radius.empty()))
-      fail_at(where,
-              "the CPU hair pass needs radii on all of its strand items or on none (this item "
-              "{} them)",
-              s.radius.empty() ? "lacks" : "has");
     const std::size_t ns = s.num_strands();
     for (std::size_t st = 0; st < ns; ++st)
       if (s.offsets[st + 1] < s.offsets[st]) fail_at(where, "offsets decrease at strand {}", st);
@@ -835,16 +845,23 @@ class GlRenderer final : public Renderer {
           m_hair_base[p0 + i] = s.color.empty() ? mc : s.color[i];
         },
         4096);
-    if (!s.radius.empty()) {
+    // Radii: per point when any item has them; the points of items without keep their
+    // strand's screen width (HairSegments::kNoRadius).
+    if (!s.radius.empty() && m_hair.radius.empty())
+      m_hair.radius.assign(p0, HairSegments::kNoRadius);
+    if (!m_hair.radius.empty()) {
       const float scale = float(linear_scale(xf));
-      m_hair.radius.resize(p0 + np);
-      for (std::size_t i = 0; i < np; ++i) m_hair.radius[p0 + i] = s.radius[i] * scale;
+      m_hair.radius.resize(p0 + np, HairSegments::kNoRadius);
+      if (!s.radius.empty())
+        for (std::size_t i = 0; i < np; ++i) m_hair.radius[p0 + i] = s.radius[i] * scale;
     }
     for (std::size_t st = 0; st < ns; ++st)
       m_hair.offsets.push_back(uint32_t(p0 + s.offsets[st + 1]));
     m_hair.width_px.resize(m_hair.num_strands(), float(mat.width_px * k));
     m_hair.opacity.resize(m_hair.num_strands(), float(mat.opacity));
-    m_hair.casts_shadow.resize(m_hair.num_strands(), item.hair_shadow ? 1 : 0);
+    // Cast into the hair shadow buffers (and so onto the meshes): hair_shadow items, and in
+    // the CPU strand pass every item that casts shadows (as the GL lines would).
+    m_hair.casts_shadow.resize(m_hair.num_strands(), item.hair_shadow || item.cast_shadow ? 1 : 0);
     h.strand_end = m_hair.num_strands();
     m_hair_items.push_back(h);
     if (shadow_box && np > 0) {
@@ -897,6 +914,8 @@ class GlRenderer final : public Renderer {
       h.shadow = m_hair_shadow[li].size > 0 ? &m_hair_shadow[li] : nullptr;
       lights.push_back(h);
     }
+    std::vector<HairLight> unshadowed = lights;  // for the items that hair does not shadow
+    for (HairLight& h : unshadowed) h.shadow = nullptr;
     m_hair_color.resize(m_hair.num_points());
     for (const CpuHairItem& h : m_hair_items) {
       const StrandMaterial& mat = h.item->material;
@@ -912,11 +931,12 @@ class GlRenderer final : public Renderer {
       sh.shadow_bias = mat.shadow_bias;
       sh.shadow_slope_bias = mat.shadow_slope_bias;
       sh.shadow_filter_radius = mat.shadow_filter_radius;
-      sh.key_light = shadow_light;
+      const bool shadowed = is_shadowed_hair(*h.item);
+      sh.key_light = shadowed ? shadow_light : -1;
       const std::string where = fmt::format("render: strands[{}].material", h.index);
       sh.check(where);
-      shade_hair_vertices(ctx, m_hair, h.strand_begin, h.strand_end, m_hair_base, sh, lights,
-                          scene.camera.eye, m_hair_color);
+      shade_hair_vertices(ctx, m_hair, h.strand_begin, h.strand_end, m_hair_base, sh,
+                          shadowed ? lights : unshadowed, scene.camera.eye, m_hair_color);
     }
     m_hair_blender.prepare(ctx, view_proj, m_hair, m_fb_w, m_fb_h, k);
     const std::array<int, 4> box = m_hair_blender.bounds();

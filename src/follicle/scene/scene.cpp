@@ -37,6 +37,9 @@ void Scene::validate(const JsonSource& src) const {
   if (const std::string e = render::RenderSettings::hair_light_pass_error(render.hair_view_pass);
       !e.empty())
     json_fail(src, "render.hair_view_pass", e);
+  if (const std::string e = render::RenderSettings::hair_light_pass_error(render.strand_pass);
+      !e.empty())
+    json_fail(src, "render.strand_pass", e);
   std::set<std::string> names;
   for (std::size_t i = 0; i < assets.meshes.size(); ++i) {
     const auto& m = assets.meshes[i];

@@ -184,6 +184,7 @@ struct RenderSpec {
   int shadow_map_size = 2048;
   std::string hair_light_pass = "cpu";  // render::RenderSettings::hair_light_pass
   std::string hair_view_pass = "cpu";   // render::RenderSettings::hair_view_pass
+  std::string strand_pass = "cpu";      // render::RenderSettings::strand_pass
 
   template <class V>
   void visit(V&& v) {
@@ -201,6 +202,11 @@ struct RenderSpec {
     v("hair_view_pass", hair_view_pass,
       ParamInfo{"hair splat view pass (Bando 2003 §3.4): \"cpu\" billboards blended on the "
                 "CPU (fast on a software rasteriser), or \"gpu\" drawn with GL"});
+    v("strand_pass", strand_pass,
+      ParamInfo{"strand hair (Anjyo, Daldegan, imported grooms): \"cpu\" antialiased lines "
+                "blended in depth order on the CPU (Daldegan 1993 §4; fast on a software "
+                "rasteriser), or \"gpu\" GL lines (Daldegan-shaded and shadowed hair stays on "
+                "the CPU)"});
   }
 };
 

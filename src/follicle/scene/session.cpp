@@ -271,6 +271,7 @@ render::RenderSettings Session::render_settings() const {
   s.shadow_map_size = m_scene.render.shadow_map_size;
   s.hair_light_pass = m_scene.render.hair_light_pass;
   s.hair_view_pass = m_scene.render.hair_view_pass;
+  s.strand_pass = m_scene.render.strand_pass;
   return s;
 }
 

@@ -633,6 +633,13 @@ TEST(DaldeganBlend, BadInputIsAClearError) {
               blend_hair(ctx, pixel_camera(8, 8), bad, colours(bad, Vec3f(1, 1, 1)), f.target());
             }).find("not finite"),
             std::string::npos);
+  // A negative radius other than kNoRadius is refused; kNoRadius (no world width) is not.
+  HairSegments neg = h;
+  neg.radius = {0.01f, -0.5f};
+  EXPECT_NE(msg([&] { rasterize_hair_depth(ctx, neg, ortho_light(), 16); }).find("radius -0.5"),
+            std::string::npos);
+  neg.radius = {0.01f, HairSegments::kNoRadius};
+  EXPECT_EQ(msg([&] { rasterize_hair_depth(ctx, neg, ortho_light(), 16); }), "no error");
   // zero-size buffers and frames
   EXPECT_NE(msg([&] { rasterize_hair_depth(ctx, h, ortho_light(), 0); }).find("size 0"),
             std::string::npos);
@@ -722,6 +729,7 @@ RenderScene hair_over_plane(bool hair_shadow, int n = 40) {
   si.material.shading = StrandShading::Daldegan1993;
   si.material.color = Vec3(0.6, 0.4, 0.2);
   si.hair_shadow = hair_shadow;
+  si.cast_shadow = hair_shadow;  // without either the hair casts nothing
   s.strands.push_back(si);
   return s;
 }
@@ -843,7 +851,8 @@ TEST_F(DaldeganGl, HairShadowDarkensThePlaneUnderIt) {
 TEST_F(DaldeganGl, VertexColourHairCastsAndReceivesShadows) {
   // Anjyo-style colours (StrandShading::VertexColor) with hair_shadow: the colours are kept
   // (times the shadow factor of the key light) and the hair shadows the plane like the
-  // Daldegan1993 items. Without hair_shadow they are GL lines (here casting nothing).
+  // Daldegan1993 items. Without hair_shadow (and cast_shadow) they are lit without shadows and
+  // cast nothing.
   const int w = 128, h = 128;
   auto scene = [](bool hair_shadow) {
     RenderScene s = hair_over_plane(hair_shadow);

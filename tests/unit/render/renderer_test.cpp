@@ -1,3 +1,4 @@
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -178,7 +179,11 @@ TEST_F(Renderer_, SphereCastsShadowOnQuad) {
   EXPECT_NEAR(luminance(lit, int(in.x()), int(in.y())), lum_out, 3.0);
 }
 
-TEST_F(Renderer_, StrandsWithVertexColoursAppear) {
+// Both strand passes (RenderSettings::strand_pass): the CPU pass (default, antialiased lines
+// blended in depth order) and GL lines draw the same colours at the same places and width.
+class RendererStrandPass : public RenderTest, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(RendererStrandPass, StrandsWithVertexColoursAppear) {
   RenderScene s;
   s.camera.eye = Vec3(0, 0, 3);
   s.background = Vec3(0, 0, 0);
@@ -192,8 +197,10 @@ TEST_F(Renderer_, StrandsWithVertexColoursAppear) {
   it.material.width_px = 2.0;
   s.strands.push_back(it);
   const int w = 128, h = 128;
-  const auto img = renderer().render(s, small(w, h));
-  maybe_save(img, "lines.png");
+  RenderSettings rs = small(w, h);
+  rs.strand_pass = GetParam();
+  const auto img = renderer().render(s, rs);
+  maybe_save(img, fmt::format("lines_{}.png", GetParam()));
   const Vec2 top = *project_to_pixel(s.camera, w, h, Vec3(0.3, 0.5, 0));
   const Vec2 bot = *project_to_pixel(s.camera, w, h, Vec3(0.3, -0.5, 0));
   // Sum a 1x5 column across the line: a 2-px wide line gives about 2 px of full colour.
@@ -213,9 +220,91 @@ TEST_F(Renderer_, StrandsWithVertexColoursAppear) {
   auto st2 = std::make_shared<geom::StrandSet>(*st);
   st2->radius.assign(st2->points.size(), 0.01f);
   s.strands[0].strands = st2;
-  const auto img2 = renderer().render(s, small(w, h));
+  const auto img2 = renderer().render(s, rs);
   EXPECT_GT(img2.at(int(top.x()), int(top.y()), 0), 30);
 }
+
+// Items with and without per-point radii together (in the CPU pass one segment list holds
+// both: HairSegments::kNoRadius): each keeps its own width.
+TEST_P(RendererStrandPass, ItemsWithAndWithoutRadiiDrawTogether) {
+  RenderScene s;
+  s.camera.eye = Vec3(0, 0, 3);
+  s.background = Vec3(0, 0, 0);
+  auto line = [](float y, Vec3f c, float radius) {
+    auto st = std::make_shared<geom::StrandSet>();
+    st->add_strand({Vec3f(-1, y, 0), Vec3f(0, y, 0), Vec3f(1, y, 0)});
+    st->color.assign(3, c);
+    if (radius > 0) st->radius.assign(3, radius);
+    StrandItem it;
+    it.strands = st;
+    it.material.shading = StrandShading::VertexColor;
+    it.material.width_px = 1.0;
+    return it;
+  };
+  s.strands.push_back(line(0.5f, Vec3f(1, 0, 0), 0));       // 1 px
+  s.strands.push_back(line(-0.5f, Vec3f(0, 1, 0), 0.02f));  // 4 cm wide: several pixels
+  s.strands.push_back(line(0.0f, Vec3f(0, 0, 1), 0));       // 1 px again, after the radii
+  const int w = 128, h = 128;
+  RenderSettings rs = small(w, h);
+  rs.strand_pass = GetParam();
+  const auto img = renderer().render(s, rs);
+  maybe_save(img, fmt::format("mixed_radii_{}.png", GetParam()));
+  auto column = [&](float y, int c) {
+    const Vec2 p = *project_to_pixel(s.camera, w, h, Vec3(0.3, y, 0));
+    double sum = 0;
+    for (int dy = -8; dy <= 8; ++dy) sum += srgb_to_linear(img.at(int(p.x()), int(p.y()) + dy, c));
+    return sum;
+  };
+  // Pixels per metre at the strands' depth: h / (2 tan(fov / 2) 3 m).
+  const double px_per_m = h / (2 * std::tan(0.5 * s.camera.fov_y) * 3.0);
+  EXPECT_NEAR(column(0.5f, 0), 1.0, 0.25);
+  EXPECT_NEAR(column(0.0f, 2), 1.0, 0.25);
+  EXPECT_NEAR(column(-0.5f, 1), 0.04 * px_per_m, 0.25 * 0.04 * px_per_m);
+}
+
+// The CPU pass's strands cast shadows onto the meshes when cast_shadow is set (as GL lines do
+// through the shadow map), and none without it.
+TEST_P(RendererStrandPass, CastingStrandsShadowTheGround) {
+  RenderScene s;
+  s.camera.eye = Vec3(0, 3, 6);
+  s.camera.target = Vec3(0, -1, 0);
+  s.camera.fov_y = 0.8;
+  DirectionalLight l;
+  l.direction = Vec3(0, -1, 0);  // straight down: the strands' shadow lies under them
+  s.lights.push_back(l);
+  MeshItem ground;
+  ground.mesh = make_quad(Vec3(0, -1, 0), Vec3(6, 0, 0), Vec3(0, 0, -6));
+  ground.material.base_color = Vec3(0.7, 0.7, 0.7);
+  ground.material.specular = 0;
+  s.meshes.push_back(ground);
+  // A dense flat mat of strands at y = 0 over x in [-0.5, 0.5], z in [-0.5, 0.5].
+  auto st = std::make_shared<geom::StrandSet>();
+  for (int i = 0; i <= 200; ++i) {
+    const float z = -0.5f + 0.005f * float(i);
+    st->add_strand({Vec3f(-0.5f, 0, z), Vec3f(0.5f, 0, z)});
+  }
+  StrandItem it;
+  it.strands = st;
+  it.material.width_px = 1.0;
+  s.strands.push_back(it);
+  const int w = 160, h = 120;
+  RenderSettings rs = small(w, h);
+  rs.strand_pass = GetParam();
+  const auto img = renderer().render(s, rs);
+  maybe_save(img, fmt::format("strand_shadow_{}.png", GetParam()));
+  // A ground point under the mat that the camera sees past the mat's front edge (the ray to it
+  // crosses y = 0 at z = 1.7), against one beside the mat.
+  const Vec2 under = *project_to_pixel(s.camera, w, h, Vec3(0, -1, 0.3));
+  const Vec2 beside = *project_to_pixel(s.camera, w, h, Vec3(1.5, -1, 0.3));
+  const double lum_under = luminance(img, int(under.x()), int(under.y()));
+  const double lum_beside = luminance(img, int(beside.x()), int(beside.y()));
+  EXPECT_LT(lum_under, 0.6 * lum_beside);
+  s.strands[0].cast_shadow = false;
+  const auto lit = renderer().render(s, rs);
+  EXPECT_NEAR(luminance(lit, int(under.x()), int(under.y())), lum_beside, 3.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Passes, RendererStrandPass, ::testing::Values("cpu", "gpu"));
 
 TEST_F(Renderer_, ParticlesDrawAsDiscs) {
   RenderScene s;

@@ -97,6 +97,9 @@ TEST(SceneFile, StrictKeysWithPaths) {
   EXPECT_THAT(
       error_of(R"({"follicle_scene": 1, "assets": {"meshes": [{"path": "a", "units": "inch"}]}})"),
       HasSubstr("assets.meshes[0].units: unknown value \"inch\""));
+  EXPECT_THAT(
+      error_of(R"({"follicle_scene": 1, "render": {"strand_pass": "vulkan"}})"),
+      HasSubstr("render.strand_pass: unknown value \"vulkan\"; expected \"cpu\" or \"gpu\""));
 }
 
 TEST(SceneFile, CrossFieldValidation) {
