@@ -859,8 +859,8 @@ class GlRenderer final : public Renderer {
       m_hair.offsets.push_back(uint32_t(p0 + s.offsets[st + 1]));
     m_hair.width_px.resize(m_hair.num_strands(), float(mat.width_px * k));
     m_hair.opacity.resize(m_hair.num_strands(), float(mat.opacity));
-    // Cast into the hair shadow buffers (and so onto the meshes): hair_shadow items, and in
-    // the CPU strand pass every item that casts shadows (as the GL lines would).
+    // Cast into the hair shadow buffers (and so onto the meshes and the shadowed hair):
+    // hair_shadow items and those with cast_shadow (as GL lines cast into the shadow map).
     m_hair.casts_shadow.resize(m_hair.num_strands(), item.hair_shadow || item.cast_shadow ? 1 : 0);
     h.strand_end = m_hair.num_strands();
     m_hair_items.push_back(h);
