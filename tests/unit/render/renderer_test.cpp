@@ -181,7 +181,17 @@ TEST_F(Renderer_, SphereCastsShadowOnQuad) {
 
 // Both strand passes (RenderSettings::strand_pass): the CPU pass (default, antialiased lines
 // blended in depth order) and GL lines draw the same colours at the same places and width.
-class RendererStrandPass : public RenderTest, public ::testing::WithParamInterface<const char*> {};
+class RendererStrandPass : public RenderTest, public ::testing::WithParamInterface<const char*> {
+ protected:
+  /// `s` rendered at w x h with this test's strand pass (saved as `name`_pass.png).
+  image::ImageRGBA8 render_pass(const RenderScene& s, int w, int h, const std::string& name) {
+    RenderSettings rs = small(w, h);
+    rs.strand_pass = GetParam();
+    auto img = renderer().render(s, rs);
+    maybe_save(img, fmt::format("{}_{}.png", name, GetParam()));
+    return img;
+  }
+};
 
 TEST_P(RendererStrandPass, StrandsWithVertexColoursAppear) {
   RenderScene s;
@@ -197,10 +207,7 @@ TEST_P(RendererStrandPass, StrandsWithVertexColoursAppear) {
   it.material.width_px = 2.0;
   s.strands.push_back(it);
   const int w = 128, h = 128;
-  RenderSettings rs = small(w, h);
-  rs.strand_pass = GetParam();
-  const auto img = renderer().render(s, rs);
-  maybe_save(img, fmt::format("lines_{}.png", GetParam()));
+  const auto img = render_pass(s, w, h, "lines");
   const Vec2 top = *project_to_pixel(s.camera, w, h, Vec3(0.3, 0.5, 0));
   const Vec2 bot = *project_to_pixel(s.camera, w, h, Vec3(0.3, -0.5, 0));
   // Sum a 1x5 column across the line: a 2-px wide line gives about 2 px of full colour.
@@ -220,7 +227,7 @@ TEST_P(RendererStrandPass, StrandsWithVertexColoursAppear) {
   auto st2 = std::make_shared<geom::StrandSet>(*st);
   st2->radius.assign(st2->points.size(), 0.01f);
   s.strands[0].strands = st2;
-  const auto img2 = renderer().render(s, rs);
+  const auto img2 = render_pass(s, w, h, "ribbons");
   EXPECT_GT(img2.at(int(top.x()), int(top.y()), 0), 30);
 }
 
@@ -245,10 +252,7 @@ TEST_P(RendererStrandPass, ItemsWithAndWithoutRadiiDrawTogether) {
   s.strands.push_back(line(-0.5f, Vec3f(0, 1, 0), 0.02f));  // 4 cm wide: several pixels
   s.strands.push_back(line(0.0f, Vec3f(0, 0, 1), 0));       // 1 px again, after the radii
   const int w = 128, h = 128;
-  RenderSettings rs = small(w, h);
-  rs.strand_pass = GetParam();
-  const auto img = renderer().render(s, rs);
-  maybe_save(img, fmt::format("mixed_radii_{}.png", GetParam()));
+  const auto img = render_pass(s, w, h, "mixed_radii");
   auto column = [&](float y, int c) {
     const Vec2 p = *project_to_pixel(s.camera, w, h, Vec3(0.3, y, 0));
     double sum = 0;
@@ -288,10 +292,7 @@ TEST_P(RendererStrandPass, CastingStrandsShadowTheGround) {
   it.material.width_px = 1.0;
   s.strands.push_back(it);
   const int w = 160, h = 120;
-  RenderSettings rs = small(w, h);
-  rs.strand_pass = GetParam();
-  const auto img = renderer().render(s, rs);
-  maybe_save(img, fmt::format("strand_shadow_{}.png", GetParam()));
+  const auto img = render_pass(s, w, h, "strand_shadow");
   // A ground point under the mat that the camera sees past the mat's front edge (the ray to it
   // crosses y = 0 at z = 1.7), against one beside the mat.
   const Vec2 under = *project_to_pixel(s.camera, w, h, Vec3(0, -1, 0.3));
@@ -300,7 +301,7 @@ TEST_P(RendererStrandPass, CastingStrandsShadowTheGround) {
   const double lum_beside = luminance(img, int(beside.x()), int(beside.y()));
   EXPECT_LT(lum_under, 0.6 * lum_beside);
   s.strands[0].cast_shadow = false;
-  const auto lit = renderer().render(s, rs);
+  const auto lit = render_pass(s, w, h, "strand_no_shadow");
   EXPECT_NEAR(luminance(lit, int(under.x()), int(under.y())), lum_beside, 3.0);
 }
 
