@@ -52,8 +52,7 @@ struct HairSegments {
   /// Throws follicle::Error, prefixed by `where`, naming the first bad strand or point:
   /// offsets that do not start at 0, decrease or do not end at the point count; per-strand or
   /// per-point arrays of the wrong size; a point that is not finite; a radius < 0 other than
-  /// kNoRadius; a width
-  /// <= 0; an opacity outside [0, 1] (or NaN).
+  /// kNoRadius; a width <= 0; an opacity outside [0, 1] (or NaN).
   void check(const std::string& where) const;
 };
 
