@@ -641,7 +641,7 @@ class GlRenderer final : public Renderer {
         if (!scene.lights[li].cast_shadow || int(li) == shadow_light) continue;
         const Mat4 vp = light_matrix(li);
         draw_shadow_casters(vp);
-        hair_shadow_buffer(li, vp, settings.shadow_map_size, false);
+        hair_shadow_buffer(li, vp, settings.shadow_map_size, hair_casts, false);
       }
     }
     if (shadows) {
@@ -653,7 +653,8 @@ class GlRenderer final : public Renderer {
       draw_shadow_casters(light_vp);
       // The composite buffer replaces the scene's, so the hair shadows the meshes (step 4).
       if (hair_shadowed || hair_casts)
-        hair_shadow_buffer(std::size_t(shadow_light), light_vp, settings.shadow_map_size, true);
+        hair_shadow_buffer(std::size_t(shadow_light), light_vp, settings.shadow_map_size,
+                           hair_casts, true);
       if (!m_splat->empty()) {
         SplatPassGl::Light sl;
         sl.index = shadow_light;
@@ -874,8 +875,9 @@ class GlRenderer final : public Renderer {
 
   /// Steps (1)-(3) for light `li`: the scene's depth map just drawn into the shadow framebuffer
   /// read back, the hair's drawn on the CPU, their composite kept in m_hair_shadow[li]; with
-  /// `upload` (the mesh pass's light) the composite replaces the shadow map when hair casts.
-  void hair_shadow_buffer(std::size_t li, const Mat4& vp, int size, bool upload) {
+  /// `upload` (the mesh pass's light) the composite replaces the shadow map. Without `casts`
+  /// (no item casts) the composite is the scene's map itself.
+  void hair_shadow_buffer(std::size_t li, const Mat4& vp, int size, bool casts, bool upload) {
     ShadowBuffer& buf = m_hair_shadow[li];
     buf.size = size;
     buf.light_vp = vp;
@@ -884,8 +886,6 @@ class GlRenderer final : public Renderer {
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, size, size, GL_DEPTH_COMPONENT, GL_FLOAT, buf.depth.data());
     check_gl("shadow map read-back");
-    const bool casts = std::any_of(m_hair.casts_shadow.begin(), m_hair.casts_shadow.end(),
-                                   [](uint8_t c) { return c != 0; });
     if (!casts) return;
     m_hair_rasterizer.rasterize(*m_hair_ctx, m_hair, vp, size, m_hair_depth_map);
     compose_shadow_buffers_into(*m_hair_ctx, buf, m_hair_depth_map);
